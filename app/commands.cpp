@@ -1,0 +1,13 @@
+#include "app/commands.hpp"
+
+namespace furrow::cli {
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> all = {
+      command_run(), command_validate(), command_new(), command_templates(),
+      command_render(), command_demo(),
+  };
+  return all;
+}
+
+}  // namespace furrow::cli

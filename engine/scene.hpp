@@ -1,0 +1,127 @@
+// Scene: the validated, immutable description of a run (SI units throughout).
+// Built from JSON by engine/scene_io; the solver never changes it.
+#pragma once
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace furrow {
+
+using Vec2 = Eigen::Vector2d;
+
+enum class ShapeFunction { Linear, Quadratic, Cubic };
+enum class MaterialModel { NDPM, DPM };
+
+struct Material {
+  std::string name = "sand";
+  MaterialModel model = MaterialModel::NDPM;
+  double grain_density_kg_m3 = 2520.0;  // rho_g
+  double phi_c = 0.60;                  // close-packed (NDPM) / critical-state (DPM) packing fraction
+  double mu = 0.40;                     // NDPM: mu_s; DPM: mu_c (friction at phi_d = phi_c)
+  double chi = 0.0;                     // DPM dilatancy scale; 0 reduces DPM to NDPM
+  double phi_min = 0.45;                // DPM: phi_d resets here when material opens below it
+  double youngs_modulus_Pa = 5.0e6;     // small elastic part: "just stiff enough"
+  double poisson_ratio = 0.3;
+};
+
+struct Bed {
+  std::string material;  // name of an entry in Scene::materials
+  Vec2 min_m{0.0, 0.0};  // region (axis-aligned box)
+  Vec2 max_m{0.0, 0.0};
+  double packing_fraction = 0.60;  // initial phi (DPM: initial phi_d too)
+  double k0 = -1.0;                // lateral earth-pressure ratio; < 0 means Jaky: 1 - sin(atan mu)
+};
+
+struct Shape {
+  enum class Kind { Circle, Box, Polygon, Union };
+  Kind kind = Kind::Box;
+  double radius_m = 0.0;               // circle
+  Vec2 size_m{0.0, 0.0};               // box: full width and height
+  std::vector<Vec2> vertices_m;        // polygon: convex, counter-clockwise, body frame
+  std::vector<Shape> parts;            // union
+  Vec2 offset_m{0.0, 0.0};             // position of this shape in its parent's frame
+};
+
+struct Motion {
+  enum class Kind { ConstantVelocity, Path };
+  Kind kind = Kind::ConstantVelocity;
+  Vec2 velocity_m_s{0.0, 0.0};
+  // piecewise-linear velocity in time: (t_s, vx, vy) knots; held constant after the last knot
+  struct Knot { double t_s; Vec2 velocity_m_s; };
+  std::vector<Knot> path;
+};
+
+struct Body {
+  std::string name = "body";
+  Shape shape;
+  Vec2 start_m{0.0, 0.0};  // position of the shape's origin (box/circle centre) at t = 0
+  Motion motion;
+  double friction = 0.35;  // mu_f, Coulomb, body against media
+};
+
+struct Wall {
+  enum class Kind { Slip, Friction, Sticky, Open };
+  Kind kind = Kind::Slip;
+  double friction = 0.0;
+};
+
+struct Walls {
+  Wall left, right, bottom, top{Wall::Kind::Open, 0.0};
+};
+
+struct Effects {
+  bool gravity = true;
+  Vec2 gravity_m_s2{0.0, -9.81};
+  bool dilatancy = false;        // DPM state evolution; forced off for NDPM materials
+  bool separation = true;        // stress-free when open (rho < rho_d)
+  bool body_friction = true;
+  bool wall_friction = true;
+};
+
+struct Outputs {
+  double frame_interval_s = 0.0;   // 0: no frames
+  std::vector<std::string> fields; // e.g. "pressure", "strain_rate", "packing_fraction", "velocity"
+  std::vector<std::string> movies; // subset of fields rendered to movies/<field>.mp4
+  double force_interval_s = 0.0;   // 0: one forces.csv row per body per step
+  // summary window for mean forces: by time, or by body displacement when set (> 0)
+  double average_from_s = 0.0, average_to_s = -1.0;
+  double average_from_m = -1.0, average_to_m = -1.0;
+};
+
+struct Solver {
+  ShapeFunction shape_function = ShapeFunction::Quadratic;
+  int particles_per_cell_1d = 2;   // 2 -> 4 particles per cell
+  double cfl = 0.4;
+  double end_time_s = 1.0;
+  double end_displacement_m = -1.0;  // stop when the first moving body has travelled this far (> 0)
+  int threads = 0;                   // 0: all hardware threads
+  int max_steps = 50'000'000;        // guard against runaway scenes
+};
+
+struct Domain {
+  double width_m = 1.0, height_m = 1.0;
+  double dx_m = 0.01;
+};
+
+struct Scene {
+  int schema_version = 1;
+  std::string name = "scene";
+  std::string description;
+  Domain domain;
+  Solver solver;
+  std::vector<Material> materials;
+  std::vector<Bed> beds;
+  std::vector<Body> bodies;
+  Walls walls;
+  Effects effects;
+  Outputs outputs;
+
+  const Material* find_material(const std::string& name) const {
+    for (const auto& m : materials)
+      if (m.name == name) return &m;
+    return nullptr;
+  }
+};
+
+}  // namespace furrow

@@ -1,0 +1,3 @@
+namespace furrow::render {
+int placeholder() { return 0; }
+}  // namespace furrow::render
