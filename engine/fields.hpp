@@ -1,0 +1,64 @@
+// The one registry of output fields (name, unit, how to show it) and the per-frame data handed
+// from the solver to the field store and from the store to the renderer.
+#pragma once
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace furrow {
+
+struct FieldInfo {
+  std::string name;         // grid name in VDB files and scene "outputs.fields"
+  std::string unit;         // for colorbars and CSV headers
+  std::string label;        // human title, e.g. "Pressure"
+  bool vector = false;      // velocity only
+  bool log_scale = false;   // strain rate is shown on a log scale
+  bool dpm_only = false;    // phi_d exists only when the scene's material is DPM
+};
+
+// All fields Furrow can store, in a stable order.
+const std::vector<FieldInfo>& field_registry();
+const FieldInfo* find_field(const std::string& name);
+
+// Read-only view of particle arrays (structure of arrays) for rasterization. Null pointers mean
+// "not computed for this run" and the corresponding fields are skipped.
+struct ParticleView {
+  size_t count = 0;
+  const double* x_m = nullptr;
+  const double* y_m = nullptr;
+  const double* mass_kg = nullptr;        // per metre out of plane
+  const double* volume_m2 = nullptr;      // current area (per metre out of plane)
+  const double* vx_m_s = nullptr;
+  const double* vy_m_s = nullptr;
+  const double* pressure_Pa = nullptr;
+  const double* strain_rate_1_s = nullptr;   // equivalent plastic shear rate
+  const double* plastic_strain = nullptr;    // equivalent plastic shear strain
+  const double* phi_d = nullptr;             // DPM state
+  const double* grain_density_kg_m3 = nullptr;  // per particle rho_g (packing = m / (rho_g V))
+};
+
+// A body as drawn in a frame: its outline polygon in world coordinates and the force it feels.
+struct BodyOutline {
+  std::string name;
+  std::vector<Eigen::Vector2d> outline_m;  // closed loop, counter-clockwise
+  Eigen::Vector2d position_m{0, 0};
+  Eigen::Vector2d force_N_per_m{0, 0};
+};
+
+// Fields rasterized on cells (cell (i,j) centre at origin + (i+0.5, j+0.5) dx). Row-major, i fastest.
+struct FieldFrame {
+  std::string scene_name;
+  int64_t step = 0;
+  double time_s = 0.0, dt_s = 0.0, dx_m = 0.0;
+  Eigen::Vector2d origin_m{0, 0};
+  int nx = 0, ny = 0;
+  std::vector<uint8_t> active;                        // 1 where material is present
+  std::map<std::string, std::vector<float>> scalars;  // name -> nx*ny values
+  std::vector<float> velocity_x, velocity_y;          // empty unless "velocity" requested
+  std::vector<BodyOutline> bodies;
+  size_t index(int i, int j) const { return size_t(j) * size_t(nx) + size_t(i); }
+};
+
+}  // namespace furrow
