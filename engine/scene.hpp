@@ -31,6 +31,7 @@ struct Bed {
   Vec2 max_m{0.0, 0.0};
   double packing_fraction = 0.60;  // initial phi (DPM: initial phi_d too)
   double k0 = -1.0;                // lateral earth-pressure ratio; < 0 means Jaky: 1 - sin(atan mu)
+  bool geostatic = true;           // start in geostatic equilibrium instead of stress-free
 };
 
 struct Shape {

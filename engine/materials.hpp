@@ -1,0 +1,121 @@
+// Rate-independent granular plasticity (paper section 2), one update per material point.
+//
+// Elasticity is split: pressure follows the volumetric strain measured from the dense state,
+// P = K ln(phi / phi_d) (so the open/dense switch of the model is exactly P <= 0), and the
+// deviatoric stress s is hypoelastic with a Jaumann rate. Plastic flow is a closed-form return:
+// open material (phi < phi_d) carries no stress; otherwise s is scaled back onto tau = mu P.
+// Plane strain: in-plane kinematics, but s_zz is carried.
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+#include "engine/scene.hpp"
+
+namespace furrow {
+
+struct MaterialParams {
+  double rho_g = 2520.0;  // grain density (kg/m^3)
+  double phi_c = 0.60;
+  double mu = 0.40;        // mu_s (NDPM) or mu_c (DPM)
+  double chi = 0.0;
+  double phi_min = 0.45;
+  double K = 0.0, G = 0.0;  // bulk and shear moduli (Pa)
+  bool separation = true;   // effects.separation: stress-free when open
+
+  static MaterialParams from(const Material& m, bool separation) {
+    MaterialParams p;
+    p.rho_g = m.grain_density_kg_m3;
+    p.phi_c = m.phi_c;
+    p.mu = m.mu;
+    p.chi = m.model == MaterialModel::DPM ? m.chi : 0.0;
+    p.phi_min = m.phi_min;
+    p.K = m.youngs_modulus_Pa / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
+    p.G = m.youngs_modulus_Pa / (2.0 * (1.0 + m.poisson_ratio));
+    p.separation = separation;
+    return p;
+  }
+  // friction at dense-state packing phi_d; never negative
+  double friction(double phi_d) const { return std::max(0.0, mu + (phi_d - phi_c) * chi); }
+};
+
+// Everything the constitutive law reads and writes for one material point.
+struct PointState {
+  double volume_m2;          // current area per metre out of plane
+  double sxx, syy, sxy, szz; // deviatoric Cauchy stress (Pa)
+  double pressure_Pa;        // P = -tr(sigma)/3
+  double phi_d;              // dense-state packing (DPM); phi_c for NDPM
+  double plastic_strain;     // accumulated equivalent plastic shear strain
+  double strain_rate_1_s;    // equivalent plastic shear rate of this step
+};
+
+// Shared by both models; Dilatancy selects the DPM state law at compile time so an NDPM run
+// carries no per-particle branch or state for it.
+template <bool Dilatancy>
+struct PlasticityModel {
+  MaterialParams p;
+
+  // L: velocity gradient (row-major 2x2: dvx/dx, dvx/dy, dvy/dx, dvy/dy), mass in kg per metre.
+  inline void update(double dt, double L00, double L01, double L10, double L11, double mass,
+                     PointState& s) const {
+    // kinematics: log volume strain advances by dt tr(D) (plane strain: D_zz = 0); unlike
+    // det(I + dt L) this is exactly 1 under rigid spin, so rotation never changes pressure
+    s.volume_m2 *= std::exp(dt * (L00 + L11));
+    const double phi = mass / (p.rho_g * s.volume_m2);
+    double phi_d = Dilatancy ? s.phi_d : p.phi_c;
+
+    if (p.separation && phi < phi_d) {
+      // open: stress-free; DPM forgets compaction below phi_min
+      if (Dilatancy && phi < p.phi_min) s.phi_d = p.phi_min;
+      s.sxx = s.syy = s.sxy = s.szz = 0.0;
+      s.pressure_Pa = 0.0;
+      s.strain_rate_1_s = 0.0;
+      return;
+    }
+
+    // elastic trial: Jaumann-rotated deviator plus 2G dev(D)
+    const double trD = L00 + L11;
+    const double Dxy = 0.5 * (L01 + L10), w = 0.5 * (L01 - L10);
+    const double sxx = s.sxx, syy = s.syy, sxy = s.sxy;
+    s.sxx = sxx + dt * (2.0 * p.G * (L00 - trD / 3.0) + 2.0 * w * sxy);
+    s.syy = syy + dt * (2.0 * p.G * (L11 - trD / 3.0) - 2.0 * w * sxy);
+    s.sxy = sxy + dt * (2.0 * p.G * Dxy + w * (syy - sxx));
+    s.szz = s.szz + dt * (2.0 * p.G * (-trD / 3.0));
+    // keep the deviator traceless against round-off drift
+    const double tr3 = (s.sxx + s.syy + s.szz) / 3.0;
+    s.sxx -= tr3;
+    s.syy -= tr3;
+    s.szz -= tr3;
+
+    double P = p.K * std::log(phi / phi_d);
+    const double tau = std::sqrt(0.5 * (s.sxx * s.sxx + s.syy * s.syy + s.szz * s.szz) + s.sxy * s.sxy);
+    double tau_max = p.friction(phi_d) * std::max(P, 0.0);
+    if (tau <= tau_max) {
+      s.pressure_Pa = P;
+      s.strain_rate_1_s = 0.0;
+      return;
+    }
+    // plastic: equivalent shear strain increment from the overshoot (tau = G * gamma)
+    const double dgamma = (tau - tau_max) / p.G;
+    if (Dilatancy) {
+      // d phi_d / d gamma = -chi phi_c (phi_d - phi_c): exact relaxation over the increment,
+      // monotone toward phi_c from either side
+      phi_d = p.phi_c + (phi_d - p.phi_c) * std::exp(-p.chi * p.phi_c * dgamma);
+      s.phi_d = phi_d;
+      P = p.K * std::log(phi / phi_d);
+      tau_max = p.friction(phi_d) * std::max(P, 0.0);
+    }
+    const double scale = tau > 0.0 ? tau_max / tau : 0.0;
+    s.sxx *= scale;
+    s.syy *= scale;
+    s.sxy *= scale;
+    s.szz *= scale;
+    s.pressure_Pa = P;
+    s.plastic_strain += dgamma;
+    s.strain_rate_1_s = dgamma / dt;
+  }
+};
+
+using NdpmModel = PlasticityModel<false>;
+using DpmModel = PlasticityModel<true>;
+
+}  // namespace furrow

@@ -1,0 +1,554 @@
+#include "engine/simulation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "engine/bodies.hpp"
+#include "engine/shape_functions.hpp"
+
+namespace furrow {
+
+double p_wave_speed_m_s(const Material& m) {
+  const MaterialParams p = MaterialParams::from(m, true);
+  // dense DPM material can be as loose as phi_min: lighter, hence faster waves
+  const double phi = m.model == MaterialModel::DPM ? std::min(m.phi_c, m.phi_min) : m.phi_c;
+  return std::sqrt((p.K + 4.0 / 3.0 * p.G) / (m.grain_density_kg_m3 * phi));
+}
+
+namespace {
+
+bool body_moves(const Body& b) {
+  if (b.motion.kind == Motion::Kind::ConstantVelocity) return b.motion.velocity_m_s.squaredNorm() > 0.0;
+  for (const auto& k : b.motion.path)
+    if (k.velocity_m_s.squaredNorm() > 0.0) return true;
+  return false;
+}
+
+constexpr size_t kGrain = 4096;  // particles per TBB task
+
+}  // namespace
+
+Simulation::Simulation(const Scene& scene) : scene_(scene) {
+  const auto& d = scene_.domain;
+  if (!(d.dx_m > 0.0) || !(d.width_m > 0.0) || !(d.height_m > 0.0))
+    throw std::invalid_argument("scene domain needs positive width, height and dx");
+  if (scene_.materials.empty() && !scene_.beds.empty()) throw std::invalid_argument("scene has beds but no materials");
+  if (scene_.materials.size() > 255) throw std::invalid_argument("at most 255 materials");
+  g_.dx = d.dx_m;
+  g_.nx = int(std::ceil(d.width_m / d.dx_m - 1e-9));
+  g_.ny = int(std::ceil(d.height_m / d.dx_m - 1e-9));
+  g_.NX = g_.nx + 1 + 2 * Grid::kPad;
+  g_.NY = g_.ny + 1 + 2 * Grid::kPad;
+  const size_t nodes = size_t(g_.NX) * g_.NY;
+  g_.mass.assign(nodes, 0.0);
+  g_.vx.assign(nodes, 0.0);
+  g_.vy.assign(nodes, 0.0);
+
+  bool any_dpm = false;
+  for (const auto& m : scene_.materials) {
+    materials_.push_back(MaterialParams::from(m, scene_.effects.separation));
+    wave_speed_ = std::max(wave_speed_, p_wave_speed_m_s(m));
+    any_dpm |= m.model == MaterialModel::DPM;
+  }
+  dilatancy_ = scene_.effects.dilatancy && any_dpm;
+  gravity_ = scene_.effects.gravity ? scene_.effects.gravity_m_s2 : Vec2(0.0, 0.0);
+
+  for (const auto& b : scene_.bodies) {
+    BodyState s;
+    s.position_m = b.start_m;
+    s.velocity_m_s = body_velocity(b.motion, 0.0);
+    shape_bounds(b.shape, s.lo_m, s.hi_m);
+    bodies_.push_back(s);
+  }
+  seed_beds();
+
+  switch (scene_.solver.shape_function) {
+    case ShapeFunction::Linear:
+      p2g_ = &Simulation::particles_to_grid<LinearKernel>;
+      g2p_ = &Simulation::grid_to_particles<LinearKernel>;
+      break;
+    case ShapeFunction::Quadratic:
+      p2g_ = &Simulation::particles_to_grid<QuadraticKernel>;
+      g2p_ = &Simulation::grid_to_particles<QuadraticKernel>;
+      break;
+    case ShapeFunction::Cubic:
+      p2g_ = &Simulation::particles_to_grid<CubicKernel>;
+      g2p_ = &Simulation::grid_to_particles<CubicKernel>;
+      break;
+  }
+  constitutive_ = dilatancy_ ? &Simulation::constitutive_update<true> : &Simulation::constitutive_update<false>;
+  const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
+  arena_ = std::make_unique<tbb::task_arena>(threads);
+  reorder_particles();
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::seed_beds() {
+  const int ppc = std::max(1, scene_.solver.particles_per_cell_1d);
+  const double h = g_.dx / ppc, v0 = h * h;
+  const double g = gravity_.norm();
+  for (const auto& bed : scene_.beds) {
+    const Material* mat = scene_.find_material(bed.material);
+    if (!mat) throw std::invalid_argument("bed refers to unknown material '" + bed.material + "'");
+    const uint8_t mi = uint8_t(mat - scene_.materials.data());
+    const MaterialParams& mp = materials_[mi];
+    const double phi_i = bed.packing_fraction;
+    const double phi_d = dilatancy_ && mat->model == MaterialModel::DPM ? phi_i : mp.phi_c;
+    const double k0 = bed.k0 >= 0.0 ? bed.k0 : 1.0 - std::sin(std::atan(mp.friction(phi_d)));
+    const double mass = mp.rho_g * phi_i * v0;
+    const long kx0 = long(std::floor(bed.min_m.x() / h)), kx1 = long(std::ceil(bed.max_m.x() / h));
+    const long ky0 = long(std::floor(bed.min_m.y() / h)), ky1 = long(std::ceil(bed.max_m.y() / h));
+    for (long ky = ky0; ky <= ky1; ++ky) {
+      const double y = (ky + 0.5) * h;
+      if (y < bed.min_m.y() || y >= bed.max_m.y()) continue;
+      for (long kx = kx0; kx <= kx1; ++kx) {
+        const double x = (kx + 0.5) * h;
+        if (x < bed.min_m.x() || x >= bed.max_m.x()) continue;
+        bool inside_body = false;
+        for (size_t b = 0; b < scene_.bodies.size() && !inside_body; ++b)
+          inside_body = shape_sdf(scene_.bodies[b].shape, Vec2(x, y) - bodies_[b].position_m) < 0.0;
+        if (inside_body) continue;
+        // geostatic stress: vertical rho g depth, horizontal and out-of-plane k0 times it
+        const double sv = bed.geostatic ? mp.rho_g * phi_i * g * (bed.max_m.y() - y) : 0.0;
+        const double P = sv * (1.0 + 2.0 * k0) / 3.0;
+        const bool dense = phi_i >= phi_d;
+        p_.x.push_back(x);
+        p_.y.push_back(y);
+        p_.vx.push_back(0.0);
+        p_.vy.push_back(0.0);
+        p_.mass.push_back(mass);
+        // the elastic law P = K ln(phi/phi_d) fixes the volume that carries this pressure
+        p_.volume.push_back(dense ? mass / (mp.rho_g * phi_d * std::exp(P / mp.K)) : v0);
+        p_.sxx.push_back(dense ? P - k0 * sv : 0.0);
+        p_.syy.push_back(dense ? P - sv : 0.0);
+        p_.szz.push_back(dense ? P - k0 * sv : 0.0);
+        p_.sxy.push_back(0.0);
+        p_.pressure.push_back(dense ? P : 0.0);
+        if (dilatancy_) p_.phi_d.push_back(phi_d);
+        p_.material.push_back(mi);
+      }
+    }
+  }
+  const size_t n = p_.x.size();
+  for (auto* a : {&p_.c00, &p_.c01, &p_.c10, &p_.c11, &p_.plastic_strain, &p_.strain_rate}) a->assign(n, 0.0);
+}
+
+double Simulation::next_dt_s() const {
+  double vmax = stats_.max_speed_m_s;
+  for (const auto& b : bodies_) vmax = std::max(vmax, b.velocity_m_s.norm());
+  for (size_t b = 0; b < bodies_.size(); ++b)
+    vmax = std::max(vmax, body_velocity(scene_.bodies[b].motion, t_s_).norm());
+  return scene_.solver.cfl * g_.dx / (wave_speed_ + vmax);
+}
+
+void Simulation::step() {
+  dt_s_ = next_dt_s();
+  arena_->execute([&] {
+    clear_grid();
+    sort_particles();
+    (this->*p2g_)();
+    grid_update();
+    bodies_and_walls();
+    (this->*g2p_)();
+    (this->*constitutive_)();
+  });
+  advance_bodies();
+  t_s_ += dt_s_;
+  ++steps_;
+  if (steps_ % 16 == 0) arena_->execute([&] { reorder_particles(); });
+}
+
+bool Simulation::finished() const {
+  const auto& s = scene_.solver;
+  if (t_s_ >= s.end_time_s - 1e-12) return true;
+  if (steps_ >= s.max_steps) return true;
+  return s.end_displacement_m > 0.0 && lead_body_travel_m() >= s.end_displacement_m;
+}
+
+double Simulation::lead_body_travel_m() const {
+  for (size_t b = 0; b < bodies_.size(); ++b)
+    if (body_moves(scene_.bodies[b])) return (bodies_[b].position_m - scene_.bodies[b].start_m).norm();
+  return 0.0;
+}
+
+void Simulation::clear_grid() {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.mass.size(), 1 << 14), [&](const auto& r) {
+    std::fill(g_.mass.begin() + r.begin(), g_.mass.begin() + r.end(), 0.0);
+    std::fill(g_.vx.begin() + r.begin(), g_.vx.begin() + r.end(), 0.0);
+    std::fill(g_.vy.begin() + r.begin(), g_.vy.begin() + r.end(), 0.0);
+  });
+}
+
+// Counting sort of particle indices by strip of kStripCells cell columns.
+void Simulation::sort_particles() {
+  const size_t n = p_.size();
+  const int strips = g_.nx / kStripCells + 3;
+  strip_start_.assign(strips + 1, 0);
+  scratch_u32_.resize(n);
+  const double inv = 1.0 / g_.dx;
+  for (size_t i = 0; i < n; ++i) {
+    const int s = std::clamp(int(std::floor(p_.x[i] * inv)) / kStripCells + 1, 0, strips - 1);
+    scratch_u32_[i] = uint32_t(s);
+    ++strip_start_[s + 1];
+  }
+  std::partial_sum(strip_start_.begin(), strip_start_.end(), strip_start_.begin());
+  order_.resize(n);
+  std::vector<uint32_t> fill(strip_start_.begin(), strip_start_.end() - 1);
+  for (size_t i = 0; i < n; ++i) order_[fill[scratch_u32_[i]]++] = uint32_t(i);
+}
+
+template <class K>
+void Simulation::particles_to_grid() {
+  const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
+  const double Dinv = K::inv_D(inv_dx);
+  double* gm = g_.mass.data();
+  double* gx = g_.vx.data();
+  double* gy = g_.vy.data();
+  const auto& P = p_;
+  auto scatter_strip = [&](int s) {
+    for (uint32_t k = strip_start_[s]; k < strip_start_[s + 1]; ++k) {
+      const uint32_t p = order_[k];
+      double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
+      const double xp = P.x[p], yp = P.y[p];
+      const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
+      const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
+      const double m = P.mass[p], V = P.volume[p];
+      const double sxx = P.sxx[p] - P.pressure[p], syy = P.syy[p] - P.pressure[p], sxy = P.sxy[p];
+      const double mvx = m * P.vx[p], mvy = m * P.vy[p];
+      const double c00 = P.c00[p], c01 = P.c01[p], c10 = P.c10[p], c11 = P.c11[p];
+      for (int b = 0; b < K::N; ++b) {
+        const size_t row = g_.index(bx, by + b);
+        const double dyp = (by + b) * dx - yp;
+        for (int a = 0; a < K::N; ++a) {
+          const size_t node = row + a;
+          const double dxp = (bx + a) * dx - xp;
+          const double w = wx[a] * wy[b];
+          double fx, fy;
+          if constexpr (K::mls) {
+            // MLS: grad w ~ w D^-1 (x_i - x_p); stress and APIC terms share one affine matrix
+            const double q00 = m * c00 - dt * V * Dinv * sxx, q01 = m * c01 - dt * V * Dinv * sxy;
+            const double q10 = m * c10 - dt * V * Dinv * sxy, q11 = m * c11 - dt * V * Dinv * syy;
+            fx = w * (mvx + q00 * dxp + q01 * dyp);
+            fy = w * (mvy + q10 * dxp + q11 * dyp);
+          } else {
+            const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
+            fx = w * (mvx + m * (c00 * dxp + c01 * dyp)) - dt * V * (sxx * gxw + sxy * gyw);
+            fy = w * (mvy + m * (c10 * dxp + c11 * dyp)) - dt * V * (sxy * gxw + syy * gyw);
+          }
+          gm[node] += w * m;
+          gx[node] += fx;
+          gy[node] += fy;
+        }
+      }
+    }
+  };
+  const int strips = int(strip_start_.size()) - 1;
+  for (int colour = 0; colour < 2; ++colour)
+    tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) { scatter_strip(2 * k + colour); });
+}
+
+void Simulation::grid_update() {
+  const double dt = dt_s_, gx = gravity_.x() * dt, gy = gravity_.y() * dt;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.mass.size(), 1 << 14), [&](const auto& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const double m = g_.mass[k];
+      if (m > 0.0) {
+        g_.vx[k] = g_.vx[k] / m + gx;
+        g_.vy[k] = g_.vy[k] / m + gy;
+      } else {
+        g_.vx[k] = g_.vy[k] = 0.0;
+      }
+    }
+  });
+}
+
+namespace {
+
+// Coulomb contact of a node velocity against a surface with outward normal n moving at vb.
+// Returns true if the node was in approaching contact and its velocity was changed.
+inline bool contact(Vec2& v, const Vec2& vb, const Vec2& n, double mu) {
+  const Vec2 rel = v - vb;
+  const double vn = rel.dot(n);
+  if (vn >= 0.0) return false;
+  Vec2 vt = rel - vn * n;
+  const double t = vt.norm();
+  if (t > 0.0) vt *= std::max(0.0, t + mu * vn) / t;  // vn < 0: friction removes up to mu|vn|
+  v = vb + vt;
+  return true;
+}
+
+}  // namespace
+
+void Simulation::bodies_and_walls() {
+  const double dt = dt_s_, dx = g_.dx;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const Body& body = scene_.bodies[b];
+    BodyState& s = bodies_[b];
+    const double mu = scene_.effects.body_friction ? body.friction : 0.0;
+    const int i0 = std::max(-Grid::kPad, int(std::floor((s.position_m.x() + s.lo_m.x()) / dx)) - 1);
+    const int i1 = std::min(g_.nx + Grid::kPad, int(std::ceil((s.position_m.x() + s.hi_m.x()) / dx)) + 1);
+    const int j0 = std::max(-Grid::kPad, int(std::floor((s.position_m.y() + s.lo_m.y()) / dx)) - 1);
+    const int j1 = std::min(g_.ny + Grid::kPad, int(std::ceil((s.position_m.y() + s.hi_m.y()) / dx)) + 1);
+    Vec2 impulse(0.0, 0.0);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const size_t k = g_.index(i, j);
+        const double m = g_.mass[k];
+        if (m <= 0.0) continue;
+        const Vec2 q = Vec2(i * dx, j * dx) - s.position_m;
+        if (shape_sdf(body.shape, q) >= 0.0) continue;
+        Vec2 v(g_.vx[k], g_.vy[k]);
+        const Vec2 before = v;
+        if (!contact(v, s.velocity_m_s, shape_normal(body.shape, q, 1e-4 * dx), mu)) continue;
+        impulse += m * (v - before);
+        g_.vx[k] = v.x();
+        g_.vy[k] = v.y();
+      }
+    s.force_N_per_m = -impulse / dt;
+  }
+
+  // domain walls act on the nodes on and beyond each boundary line
+  const bool wall_friction = scene_.effects.wall_friction;
+  auto wall = [&](const Wall& w, int side, int i0, int i1, int j0, int j1, Vec2 n) {
+    Vec2 impulse(0.0, 0.0);
+    if (w.kind != Wall::Kind::Open)
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+          const size_t k = g_.index(i, j);
+          const double m = g_.mass[k];
+          if (m <= 0.0) continue;
+          Vec2 v(g_.vx[k], g_.vy[k]);
+          const Vec2 before = v;
+          if (w.kind == Wall::Kind::Sticky)
+            v.setZero();
+          else
+            contact(v, Vec2(0.0, 0.0), n,
+                    w.kind == Wall::Kind::Friction && wall_friction ? w.friction : 0.0);
+          impulse += m * (v - before);
+          g_.vx[k] = v.x();
+          g_.vy[k] = v.y();
+        }
+    wall_forces_[side] = -impulse / dt;
+  };
+  const int P = Grid::kPad, nx = g_.nx, ny = g_.ny;
+  wall(scene_.walls.left, 0, -P, 0, -P, ny + P, Vec2(1, 0));
+  wall(scene_.walls.right, 1, nx, nx + P, -P, ny + P, Vec2(-1, 0));
+  wall(scene_.walls.bottom, 2, -P, nx + P, -P, 0, Vec2(0, 1));
+  wall(scene_.walls.top, 3, -P, nx + P, ny, ny + P, Vec2(0, -1));
+}
+
+template <class K>
+void Simulation::grid_to_particles() {
+  const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
+  const double Dinv = K::inv_D(inv_dx);
+  const double xmax = scene_.domain.width_m, ymax = scene_.domain.height_m;
+  const size_t nb = bodies_.size();
+  struct Local {
+    std::vector<Vec2> impulse;
+    int64_t projected = 0;
+    double vmax2 = 0.0;
+  };
+  tbb::enumerable_thread_specific<Local> locals([&] { return Local{std::vector<Vec2>(nb, Vec2(0, 0))}; });
+  auto& P = p_;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    Local& loc = locals.local();
+    for (size_t p = r.begin(); p < r.end(); ++p) {
+      double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
+      const double xp = P.x[p], yp = P.y[p];
+      const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
+      const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
+      double vx = 0, vy = 0, b00 = 0, b01 = 0, b10 = 0, b11 = 0;
+      for (int b = 0; b < K::N; ++b) {
+        const size_t row = g_.index(bx, by + b);
+        const double dyp = (by + b) * dx - yp;
+        for (int a = 0; a < K::N; ++a) {
+          const size_t node = row + a;
+          const double w = wx[a] * wy[b];
+          const double gvx = g_.vx[node], gvy = g_.vy[node];
+          vx += w * gvx;
+          vy += w * gvy;
+          if constexpr (K::mls) {
+            const double dxp = (bx + a) * dx - xp;
+            b00 += w * gvx * dxp;
+            b01 += w * gvx * dyp;
+            b10 += w * gvy * dxp;
+            b11 += w * gvy * dyp;
+          } else {
+            const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
+            b00 += gvx * gxw;
+            b01 += gvx * gyw;
+            b10 += gvy * gxw;
+            b11 += gvy * gyw;
+          }
+        }
+      }
+      const double sc = K::mls ? Dinv : 1.0;
+      P.c00[p] = b00 * sc;
+      P.c01[p] = b01 * sc;
+      P.c10[p] = b10 * sc;
+      P.c11[p] = b11 * sc;
+      Vec2 x(xp + dt * vx, yp + dt * vy), v(vx, vy);
+      // safety net: a particle that still ended inside a body is put back on its surface; the
+      // impulse that removes its approach velocity counts in the body's force
+      for (size_t b = 0; b < nb; ++b) {
+        const BodyState& s = bodies_[b];
+        const Vec2 q = x - s.position_m;
+        if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) continue;
+        const Shape& shape = scene_.bodies[b].shape;
+        const double d = shape_sdf(shape, q);
+        if (d >= 0.0) continue;
+        const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
+        x -= d * n;
+        const Vec2 v0 = v;
+        contact(v, s.velocity_m_s, n, 0.0);
+        loc.impulse[b] += P.mass[p] * (v - v0);
+        ++loc.projected;
+      }
+      // the grid margin bounds where a particle may go; walls normally stop it well before
+      if (x.x() < -dx) { x.x() = -dx; v.x() = std::max(v.x(), 0.0); }
+      if (x.x() > xmax + dx) { x.x() = xmax + dx; v.x() = std::min(v.x(), 0.0); }
+      if (x.y() < -dx) { x.y() = -dx; v.y() = std::max(v.y(), 0.0); }
+      if (x.y() > ymax + dx) { x.y() = ymax + dx; v.y() = std::min(v.y(), 0.0); }
+      P.x[p] = x.x();
+      P.y[p] = x.y();
+      P.vx[p] = v.x();
+      P.vy[p] = v.y();
+      loc.vmax2 = std::max(loc.vmax2, v.squaredNorm());
+    }
+  });
+  stats_.projected_particles = 0;
+  double vmax2 = 0.0;
+  for (const Local& loc : locals) {
+    for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m -= loc.impulse[b] / dt;
+    stats_.projected_particles += loc.projected;
+    vmax2 = std::max(vmax2, loc.vmax2);
+  }
+  stats_.max_speed_m_s = std::sqrt(vmax2);
+}
+
+template <bool Dilatancy>
+void Simulation::constitutive_update() {
+  const double dt = dt_s_;
+  std::vector<PlasticityModel<Dilatancy>> models;
+  for (const auto& m : materials_) models.push_back({m});
+  auto& P = p_;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, P.size(), kGrain), [&](const auto& r) {
+    for (size_t p = r.begin(); p < r.end(); ++p) {
+      PointState s{P.volume[p], P.sxx[p], P.syy[p], P.sxy[p], P.szz[p], P.pressure[p],
+                   Dilatancy ? P.phi_d[p] : 0.0, P.plastic_strain[p], 0.0};
+      models[P.material[p]].update(dt, P.c00[p], P.c01[p], P.c10[p], P.c11[p], P.mass[p], s);
+      P.volume[p] = s.volume_m2;
+      P.sxx[p] = s.sxx;
+      P.syy[p] = s.syy;
+      P.sxy[p] = s.sxy;
+      P.szz[p] = s.szz;
+      P.pressure[p] = s.pressure_Pa;
+      if constexpr (Dilatancy) P.phi_d[p] = s.phi_d;
+      P.plastic_strain[p] = s.plastic_strain;
+      P.strain_rate[p] = s.strain_rate_1_s;
+    }
+  });
+}
+
+void Simulation::advance_bodies() {
+  const double t = t_s_ + dt_s_;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const Body& body = scene_.bodies[b];
+    bodies_[b].position_m = body.start_m + body_displacement(body.motion, t);
+    bodies_[b].velocity_m_s = body_velocity(body.motion, t);
+  }
+}
+
+// Physically reorder particle arrays by cell (strip-major), so P2G and G2P walk memory in order.
+void Simulation::reorder_particles() {
+  const size_t n = p_.size();
+  if (n == 0) return;
+  const double inv = 1.0 / g_.dx;
+  const int rows = g_.ny + 2 * Grid::kPad + 1, cols = g_.nx + 2 * Grid::kPad + 1;
+  const size_t keys = size_t(rows) * cols;
+  std::vector<uint32_t> key(n), start(keys + 1, 0), perm(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int cx = std::clamp(int(std::floor(p_.x[i] * inv)) + Grid::kPad, 0, cols - 1);
+    const int cy = std::clamp(int(std::floor(p_.y[i] * inv)) + Grid::kPad, 0, rows - 1);
+    const int strip = cx / kStripCells;
+    key[i] = uint32_t((size_t(strip) * rows + cy) * kStripCells + cx % kStripCells);
+    ++start[key[i] + 1];
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);
+  auto permute = [&](auto& a) {
+    if (a.empty()) return;
+    std::remove_reference_t<decltype(a)> tmp(a.size());
+    for (size_t i = 0; i < n; ++i) tmp[i] = a[perm[i]];
+    a.swap(tmp);
+  };
+  std::vector<std::vector<double>*> arrays = {&p_.x, &p_.y, &p_.vx, &p_.vy, &p_.c00, &p_.c01, &p_.c10,
+                                              &p_.c11, &p_.mass, &p_.volume, &p_.sxx, &p_.syy, &p_.sxy,
+                                              &p_.szz, &p_.pressure, &p_.phi_d, &p_.plastic_strain,
+                                              &p_.strain_rate};
+  tbb::parallel_for(size_t(0), arrays.size() + 1, [&](size_t k) {
+    if (k < arrays.size())
+      permute(*arrays[k]);
+    else
+      permute(p_.material);
+  });
+}
+
+double Simulation::total_mass() const { return std::accumulate(p_.mass.begin(), p_.mass.end(), 0.0); }
+
+Vec2 Simulation::total_momentum() const {
+  Vec2 m(0, 0);
+  for (size_t p = 0; p < p_.size(); ++p) m += p_.mass[p] * Vec2(p_.vx[p], p_.vy[p]);
+  return m;
+}
+
+double Simulation::kinetic_energy() const {
+  double e = 0.0;
+  for (size_t p = 0; p < p_.size(); ++p) e += 0.5 * p_.mass[p] * (p_.vx[p] * p_.vx[p] + p_.vy[p] * p_.vy[p]);
+  return e;
+}
+
+ParticleView Simulation::particle_view() const {
+  rho_g_cache_.resize(p_.size());
+  for (size_t p = 0; p < p_.size(); ++p) rho_g_cache_[p] = materials_[p_.material[p]].rho_g;
+  ParticleView v;
+  v.count = p_.size();
+  v.x_m = p_.x.data();
+  v.y_m = p_.y.data();
+  v.mass_kg = p_.mass.data();
+  v.volume_m2 = p_.volume.data();
+  v.vx_m_s = p_.vx.data();
+  v.vy_m_s = p_.vy.data();
+  v.pressure_Pa = p_.pressure.data();
+  v.strain_rate_1_s = p_.strain_rate.data();
+  v.plastic_strain = p_.plastic_strain.data();
+  v.phi_d = dilatancy_ ? p_.phi_d.data() : nullptr;
+  v.grain_density_kg_m3 = rho_g_cache_.data();
+  return v;
+}
+
+std::vector<BodyOutline> Simulation::body_outlines() const {
+  std::vector<BodyOutline> out;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const auto loops = shape_outline(scene_.bodies[b].shape);
+    for (size_t k = 0; k < loops.size(); ++k) {
+      BodyOutline o;
+      o.name = scene_.bodies[b].name + (k ? "#" + std::to_string(k) : "");
+      for (const auto& v : loops[k]) o.outline_m.push_back(v + bodies_[b].position_m);
+      o.position_m = bodies_[b].position_m;
+      if (k == 0) o.force_N_per_m = bodies_[b].force_N_per_m;
+      out.push_back(o);
+    }
+  }
+  return out;
+}
+
+}  // namespace furrow

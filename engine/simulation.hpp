@@ -1,0 +1,126 @@
+// Explicit plane-strain MPM over an immutable Scene. One step reads like the algorithm:
+//   clear_grid -> particles_to_grid -> grid_update -> bodies_and_walls -> grid_to_particles
+//   -> constitutive_update -> advance_bodies
+// Particles and grid are structures of arrays; the shape-function kernel and the material law are
+// chosen once per scene (templates), so the hot loops carry no per-particle feature branches.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "engine/fields.hpp"
+#include "engine/materials.hpp"
+#include "engine/scene.hpp"
+#include <tbb/task_arena.h>
+
+namespace furrow {
+
+struct Particles {
+  std::vector<double> x, y, vx, vy;            // position (m), velocity (m/s)
+  std::vector<double> c00, c01, c10, c11;      // affine velocity field = velocity gradient (1/s)
+  std::vector<double> mass, volume;            // kg and m^2 per metre out of plane
+  std::vector<double> sxx, syy, sxy, szz;      // deviatoric stress (Pa)
+  std::vector<double> pressure;                // Pa
+  std::vector<double> phi_d;                   // DPM dense-state packing; empty without dilatancy
+  std::vector<double> plastic_strain, strain_rate;
+  std::vector<uint8_t> material;               // index into Scene::materials
+  size_t size() const { return x.size(); }
+};
+
+// Dense node grid over the domain plus a margin of kPad nodes on every side.
+struct Grid {
+  static constexpr int kPad = 3;
+  int nx = 0, ny = 0;      // cells over the domain
+  int NX = 0, NY = 0;      // nodes including padding
+  double dx = 0.0;
+  std::vector<double> mass, vx, vy;  // momentum during transfer, velocity after grid_update
+  size_t index(int i, int j) const { return size_t(j + kPad) * NX + size_t(i + kPad); }
+  double node_x(size_t k) const { return (int(k % NX) - kPad) * dx; }
+  double node_y(size_t k) const { return (int(k / NX) - kPad) * dx; }
+};
+
+struct BodyState {
+  Vec2 position_m{0, 0};
+  Vec2 velocity_m_s{0, 0};
+  Vec2 force_N_per_m{0, 0};  // reaction of the media on the body in the last step
+  Vec2 lo_m{0, 0}, hi_m{0, 0};  // body-frame bounds
+};
+
+struct StepStats {
+  int64_t projected_particles = 0;  // particles pushed out of bodies by the safety projection
+  double max_speed_m_s = 0.0;
+};
+
+class Simulation {
+ public:
+  explicit Simulation(const Scene& scene);
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  void step();
+  bool finished() const;
+
+  const Scene& scene() const { return scene_; }
+  const Particles& particles() const { return p_; }
+  Particles& mutable_particles() { return p_; }  // tests and initial-condition tweaks only
+  const Grid& grid() const { return g_; }
+  const std::vector<BodyState>& bodies() const { return bodies_; }
+  // walls: reaction force on each wall in the last step (left, right, bottom, top)
+  const std::array<Vec2, 4>& wall_forces() const { return wall_forces_; }
+  double time_s() const { return t_s_; }
+  int64_t step_count() const { return steps_; }
+  double last_dt_s() const { return dt_s_; }
+  double next_dt_s() const;
+  const StepStats& stats() const { return stats_; }
+  double wave_speed_m_s() const { return wave_speed_; }
+  // distance travelled by the first moving body (m), for end_displacement and averaging windows
+  double lead_body_travel_m() const;
+
+  // diagnostics
+  double total_mass() const;
+  Vec2 total_momentum() const;
+  double kinetic_energy() const;
+
+  ParticleView particle_view() const;
+  std::vector<BodyOutline> body_outlines() const;
+
+ private:
+  void seed_beds();
+  void clear_grid();
+  void sort_particles();
+  template <class Kernel> void particles_to_grid();
+  void grid_update();
+  void bodies_and_walls();
+  template <class Kernel> void grid_to_particles();
+  template <bool Dilatancy> void constitutive_update();
+  void advance_bodies();
+  void reorder_particles();
+
+  Scene scene_;
+  Particles p_;
+  Grid g_;
+  std::vector<BodyState> bodies_;
+  std::array<Vec2, 4> wall_forces_{};
+  std::vector<MaterialParams> materials_;
+  double t_s_ = 0.0, dt_s_ = 0.0, wave_speed_ = 0.0;
+  int64_t steps_ = 0;
+  StepStats stats_;
+  Vec2 gravity_{0, 0};
+  bool dilatancy_ = false;
+  // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
+  static constexpr int kStripCells = 4;
+  std::vector<uint32_t> order_, strip_start_;
+  std::vector<uint32_t> scratch_u32_;
+  mutable std::vector<double> rho_g_cache_;
+  void (Simulation::*p2g_)() = nullptr;
+  void (Simulation::*g2p_)() = nullptr;
+  void (Simulation::*constitutive_)() = nullptr;
+  std::unique_ptr<tbb::task_arena> arena_;
+};
+
+// P-wave speed of a material's elastic part at its dense packing (m/s); sets the CFL time step.
+double p_wave_speed_m_s(const Material& m);
+
+}  // namespace furrow

@@ -1,0 +1,186 @@
+// Return mapping of the NDPM/DPM point update (paper eqs. 1-6), one material point at a time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "engine/materials.hpp"
+#include "tests/engine/test_scenes.hpp"
+
+using namespace furrow;
+
+namespace {
+
+MaterialParams ndpm() { return MaterialParams::from(test_scenes::glass_beads(0.4), true); }
+
+MaterialParams dpm(double chi) {
+  Material m = test_scenes::glass_beads(0.4);
+  m.model = MaterialModel::DPM;
+  m.chi = chi;
+  return MaterialParams::from(m, true);
+}
+
+double tau_of(const PointState& s) {
+  return std::sqrt(0.5 * (s.sxx * s.sxx + s.syy * s.syy + s.szz * s.szz) + s.sxy * s.sxy);
+}
+
+// a dense point compressed to pressure P0 with a chosen deviator
+PointState dense_point(const MaterialParams& p, double P0, double phi_d, double mass) {
+  PointState s{};
+  s.phi_d = phi_d;
+  s.volume_m2 = mass / (p.rho_g * phi_d * std::exp(P0 / p.K));
+  s.pressure_Pa = P0;
+  return s;
+}
+
+}  // namespace
+
+TEST(Ndpm, RandomStrainIncrementsStayInsideConeWithNonNegativePressure) {
+  const auto p = ndpm();
+  NdpmModel model{p};
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const double mass = 1.0e-3, dt = 1e-5;
+  int plastic = 0, open = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    PointState s = dense_point(p, 2000.0 * std::abs(n(rng)), p.phi_c, mass);
+    for (int k = 0; k < 20; ++k) {
+      const double scale = 5.0;  // velocity gradients up to ~5/s over dt: strains ~ 5e-5 per step
+      model.update(dt, scale * n(rng), scale * n(rng), scale * n(rng), scale * n(rng), mass, s);
+      const double tau = tau_of(s);
+      ASSERT_GE(s.pressure_Pa, 0.0);
+      ASSERT_LE(tau, p.mu * s.pressure_Pa * (1.0 + 1e-9) + 1e-12);
+      ASSERT_NEAR(s.sxx + s.syy + s.szz, 0.0, 1e-9 * (1.0 + s.pressure_Pa));
+      plastic += s.strain_rate_1_s > 0.0;
+      open += s.pressure_Pa == 0.0;
+    }
+  }
+  // the random walk must exercise both the cone return and the open state for this test to mean anything
+  EXPECT_GT(plastic, 1000);
+  EXPECT_GT(open, 100);
+}
+
+TEST(Ndpm, OpenMaterialCarriesNoStress) {
+  const auto p = ndpm();
+  NdpmModel model{p};
+  const double mass = 1e-3;
+  PointState s = dense_point(p, 500.0, p.phi_c, mass);
+  s.sxx = 100.0;
+  s.syy = -100.0;
+  // expand by 2% in x: phi drops below phi_c
+  model.update(1.0, 0.02, 0.0, 0.0, 0.0, mass, s);
+  EXPECT_LT(mass / (p.rho_g * s.volume_m2), p.phi_c);
+  EXPECT_EQ(s.pressure_Pa, 0.0);
+  EXPECT_EQ(tau_of(s), 0.0);
+}
+
+TEST(Ndpm, PlasticCorrectionLeavesVolumeUnchanged) {
+  const auto p = ndpm();
+  NdpmModel model{p};
+  const double mass = 1e-3, P0 = 1000.0;
+  PointState s = dense_point(p, P0, p.phi_c, mass);
+  const double v0 = s.volume_m2;
+  // simple shear: traceless L, so the volume is untouched by kinematics as well
+  const double g = 0.05;  // strain 5%: far past yield (tau_y / G ~ 2e-4)
+  model.update(1.0, 0.0, g, 0.0, 0.0, mass, s);
+  EXPECT_GT(s.strain_rate_1_s, 0.0);
+  EXPECT_EQ(s.volume_m2, v0);
+  EXPECT_NEAR(tau_of(s), p.mu * s.pressure_Pa, 1e-9 * P0);
+  EXPECT_NEAR(s.pressure_Pa, P0, 1e-9 * P0);  // no plastic volume change: P untouched by the return
+}
+
+TEST(Ndpm, ElasticTrialBelowYieldIsReturnedUnchanged) {
+  const auto p = ndpm();
+  NdpmModel model{p};
+  const double mass = 1e-3, P0 = 1000.0, dt = 1e-6, g = 1.0;
+  PointState s = dense_point(p, P0, p.phi_c, mass);
+  model.update(dt, 0.0, g, g, 0.0, mass, s);  // symmetric shear: D_xy = g, no spin
+  EXPECT_EQ(s.strain_rate_1_s, 0.0);
+  EXPECT_NEAR(s.sxy, 2.0 * p.G * g * dt, 1e-9 * p.G * g * dt);
+  EXPECT_NEAR(s.pressure_Pa, P0, 1e-9 * P0);
+}
+
+TEST(Ndpm, RigidSpinRotatesStressWithoutChangingInvariants) {
+  const auto p = ndpm();
+  NdpmModel model{p};
+  const double mass = 1e-3, P0 = 1000.0;
+  PointState s = dense_point(p, P0, p.phi_c, mass);
+  s.sxx = 150.0;
+  s.syy = -150.0;
+  s.szz = 0.0;
+  const double tau0 = tau_of(s), omega = 2.0, dt = 1e-5;
+  const int steps = int(0.25 * M_PI / omega / dt);  // rotate by 45 degrees
+  for (int k = 0; k < steps; ++k) model.update(dt, 0.0, -omega, omega, 0.0, mass, s);
+  // after 45 degrees a pure normal deviator becomes pure shear
+  EXPECT_NEAR(tau_of(s), tau0, 1e-3 * tau0);
+  EXPECT_NEAR(std::abs(s.sxy), 150.0, 0.01 * 150.0);
+  EXPECT_NEAR(s.sxx, 0.0, 0.01 * 150.0);
+  EXPECT_NEAR(s.pressure_Pa, P0, 1e-6 * P0);
+}
+
+TEST(Dpm, ZeroChiMatchesNdpmExactly) {
+  const auto pn = ndpm();
+  const auto pd = dpm(0.0);
+  NdpmModel a{pn};
+  DpmModel b{pd};
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 3.0);
+  const double mass = 1e-3;
+  PointState sa = dense_point(pn, 800.0, pn.phi_c, mass), sb = sa;
+  for (int k = 0; k < 500; ++k) {
+    const double l00 = n(rng), l01 = n(rng), l10 = n(rng), l11 = n(rng);
+    a.update(1e-5, l00, l01, l10, l11, mass, sa);
+    b.update(1e-5, l00, l01, l10, l11, mass, sb);
+    ASSERT_DOUBLE_EQ(sa.pressure_Pa, sb.pressure_Pa);
+    ASSERT_DOUBLE_EQ(sa.sxy, sb.sxy);
+    ASSERT_DOUBLE_EQ(sa.volume_m2, sb.volume_m2);
+  }
+}
+
+// phi_d relaxes toward phi_c under shear from both sides, monotonically; the sign of the
+// volumetric response follows phi_d - phi_c.
+TEST(Dpm, PhiDRelaxesTowardCriticalFromBothSides) {
+  for (double phi0 : {0.55, 0.63}) {
+    const auto p = dpm(5.0);
+    DpmModel model{p};
+    const double mass = 1e-3, dt = 1e-4;
+    PointState s = dense_point(p, 2000.0, phi0, mass);
+    double prev = std::abs(phi0 - p.phi_c);
+    double last_phi = phi0;
+    for (int k = 0; k < 400; ++k) {
+      // shear while holding volume: the pressure must move with phi_d
+      model.update(dt, 0.0, 20.0, 0.0, 0.0, mass, s);
+      const double dist = std::abs(s.phi_d - p.phi_c);
+      ASSERT_LE(dist, prev + 1e-15) << "phi0 " << phi0 << " step " << k;
+      ASSERT_EQ((s.phi_d - p.phi_c) * (phi0 - p.phi_c) >= 0.0, true);  // never overshoots
+      prev = dist;
+      last_phi = s.phi_d;
+    }
+    EXPECT_LT(std::abs(last_phi - p.phi_c), std::abs(phi0 - p.phi_c)) << phi0;
+    // at fixed volume, dilatant (phi_d falling) material gains pressure; contractant material
+    // loses it until it opens and stops evolving
+    const double phi = mass / (p.rho_g * s.volume_m2);
+    EXPECT_NEAR(s.pressure_Pa, std::max(0.0, p.K * std::log(phi / s.phi_d)), 1e-6 * p.K);
+    if (phi0 > p.phi_c) {
+      EXPECT_GT(s.pressure_Pa, 2000.0);
+      EXPECT_LT(std::abs(last_phi - p.phi_c), 0.5 * std::abs(phi0 - p.phi_c));
+    } else {
+      EXPECT_LT(s.pressure_Pa, 2000.0);
+    }
+  }
+}
+
+TEST(Dpm, OpeningBelowPhiMinResetsState) {
+  const auto p = dpm(5.0);
+  DpmModel model{p};
+  const double mass = 1e-3;
+  PointState s = dense_point(p, 0.0, 0.58, mass);
+  // expand the area by 40%: phi = 0.58 / 1.4 ~ 0.41 < phi_min
+  model.update(1.0, 0.4, 0.0, 0.0, 0.0, mass, s);
+  EXPECT_EQ(s.phi_d, p.phi_min);
+  EXPECT_EQ(s.pressure_Pa, 0.0);
+  // a small opening keeps phi_d: the material will reconsolidate at its current state
+  PointState t = dense_point(p, 0.0, 0.58, mass);
+  model.update(1.0, 0.05, 0.0, 0.0, 0.0, mass, t);
+  EXPECT_EQ(t.phi_d, 0.58);
+}
