@@ -1,0 +1,234 @@
+// OpenVDB frame files: write_frame_vdb / read_frame (layout documented in field_store.hpp).
+#include "engine/field_store.hpp"
+
+#include <nlohmann/json.hpp>
+#include <openvdb/openvdb.h>
+#include <tbb/parallel_for.h>
+
+#include <filesystem>
+#include <mutex>
+#include <stdexcept>
+
+namespace furrow {
+
+namespace {
+
+constexpr const char* kPackingAlias = "density";  // Blender shows a grid of this name unasked
+constexpr const char* kCopyOfKey = "copy_of";
+
+void init_openvdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+void check_frame(const FieldFrame& f) {
+  auto bad = [](const std::string& what) {
+    throw std::invalid_argument("write_frame_vdb: " + what);
+  };
+  if (f.nx <= 0 || f.ny <= 0 || !(f.dx_m > 0.0)) bad("frame needs nx, ny > 0 and dx_m > 0");
+  const size_t n = size_t(f.nx) * size_t(f.ny);
+  if (f.active.size() != n) bad("active mask has " + std::to_string(f.active.size()) +
+                                " cells, expected nx*ny = " + std::to_string(n));
+  for (const auto& [name, v] : f.scalars) {
+    const FieldInfo* info = find_field(name);
+    if (!info || info->vector) bad("'" + name + "' is not a scalar field of the registry");
+    if (v.size() != n) bad("field '" + name + "' has " + std::to_string(v.size()) + " cells");
+  }
+  if (f.velocity_x.size() != f.velocity_y.size() || (!f.velocity_x.empty() && f.velocity_x.size() != n))
+    bad("velocity components must both have nx*ny cells");
+  if (f.scalars.empty() && f.velocity_x.empty()) bad("frame has no fields to store");
+}
+
+nlohmann::json bodies_to_json(const std::vector<BodyOutline>& bodies) {
+  auto vec = [](const Eigen::Vector2d& v) { return nlohmann::json::array({v.x(), v.y()}); };
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& b : bodies) {
+    nlohmann::json outline = nlohmann::json::array();
+    for (const auto& v : b.outline_m) outline.push_back(vec(v));
+    out.push_back({{"name", b.name},
+                   {"position_m", vec(b.position_m)},
+                   {"force_N_per_m", vec(b.force_N_per_m)},
+                   {"outline_m", outline}});
+  }
+  return out;
+}
+
+std::vector<BodyOutline> bodies_from_json(const nlohmann::json& j) {
+  auto vec = [](const nlohmann::json& a) { return Eigen::Vector2d(a.at(0).get<double>(), a.at(1).get<double>()); };
+  std::vector<BodyOutline> bodies;
+  for (const auto& jb : j) {
+    BodyOutline b;
+    b.name = jb.at("name").get<std::string>();
+    b.position_m = vec(jb.at("position_m"));
+    b.force_N_per_m = vec(jb.at("force_N_per_m"));
+    for (const auto& v : jb.at("outline_m")) b.outline_m.push_back(vec(v));
+    bodies.push_back(std::move(b));
+  }
+  return bodies;
+}
+
+// A grid holding value_at(c) in each active cell c = index(i, j) at voxel (i, j, 0).
+template <class GridT, class ValueAt>
+typename GridT::Ptr make_grid(const FieldFrame& f, const std::string& name, const std::string& unit,
+                              const openvdb::math::Transform& xform, ValueAt value_at) {
+  auto grid = GridT::create(typename GridT::ValueType(0));
+  grid->setName(name);
+  grid->setTransform(xform.copy());
+  grid->insertMeta("unit", openvdb::StringMetadata(unit));
+  auto acc = grid->getAccessor();
+  for (int j = 0; j < f.ny; ++j)
+    for (int i = 0; i < f.nx; ++i) {
+      const size_t c = f.index(i, j);
+      if (f.active[c]) acc.setValueOn(openvdb::Coord(i, j, 0), value_at(c));
+    }
+  return grid;
+}
+
+}  // namespace
+
+void write_frame_vdb(const std::string& path, const FieldFrame& f) {
+  check_frame(f);
+  init_openvdb();
+  auto xform = openvdb::math::Transform::createLinearTransform(f.dx_m);
+  xform->postTranslate(openvdb::Vec3d(f.origin_m.x() + 0.5 * f.dx_m, f.origin_m.y() + 0.5 * f.dx_m, 0.0));
+
+  // grids in registry order; each is built independently, so build them in parallel
+  std::vector<const FieldInfo*> present;
+  for (const auto& info : field_registry())
+    if (info.vector ? !f.velocity_x.empty() : f.scalars.count(info.name) > 0) present.push_back(&info);
+  openvdb::GridPtrVec grids(present.size());
+  tbb::parallel_for(size_t(0), present.size(), [&](size_t g) {
+    const FieldInfo& info = *present[g];
+    if (info.vector) {
+      grids[g] = make_grid<openvdb::Vec3SGrid>(f, info.name, info.unit, *xform, [&](size_t c) {
+        return openvdb::Vec3s(f.velocity_x[c], f.velocity_y[c], 0.0f);
+      });
+    } else {
+      const float* v = f.scalars.at(info.name).data();
+      auto grid = make_grid<openvdb::FloatGrid>(f, info.name, info.unit, *xform, [v](size_t c) { return v[c]; });
+      grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+      grids[g] = grid;
+    }
+  });
+  for (size_t g = 0; g < present.size(); ++g) {
+    if (present[g]->name != "packing_fraction" || f.scalars.count(kPackingAlias)) continue;
+    auto alias = grids[g]->copyGrid();  // shares the tree: written once, as an instance
+    alias->setName(kPackingAlias);
+    alias->insertMeta(kCopyOfKey, openvdb::StringMetadata("packing_fraction"));
+    grids.push_back(alias);
+  }
+
+  openvdb::MetaMap meta;
+  meta.insertMeta("scene", openvdb::StringMetadata(f.scene_name));
+  meta.insertMeta("time_s", openvdb::DoubleMetadata(f.time_s));
+  meta.insertMeta("step", openvdb::Int64Metadata(f.step));
+  meta.insertMeta("dt_s", openvdb::DoubleMetadata(f.dt_s));
+  meta.insertMeta("dx_m", openvdb::DoubleMetadata(f.dx_m));
+  meta.insertMeta("nx", openvdb::Int32Metadata(f.nx));
+  meta.insertMeta("ny", openvdb::Int32Metadata(f.ny));
+  meta.insertMeta("origin_x_m", openvdb::DoubleMetadata(f.origin_m.x()));
+  meta.insertMeta("origin_y_m", openvdb::DoubleMetadata(f.origin_m.y()));
+  meta.insertMeta("dimension", openvdb::Int32Metadata(2));
+  meta.insertMeta("furrow_version", openvdb::StringMetadata(FURROW_VERSION));
+  meta.insertMeta("bodies_json", openvdb::StringMetadata(bodies_to_json(f.bodies).dump()));
+
+  write_atomically(path, [&](const std::string& tmp) {
+    openvdb::io::File file(tmp);
+    if (openvdb::io::Archive::hasBloscCompression())
+      file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+    file.write(grids, meta);
+    file.close();
+  });
+}
+
+namespace {
+
+template <class T>
+T file_meta(const openvdb::MetaMap& meta, const std::string& key, const std::string& path) {
+  auto m = meta.getMetadata<openvdb::TypedMetadata<T>>(key);
+  if (!m)
+    throw std::runtime_error("read_frame: " + path + ": metadata '" + key +
+                             "' is missing or has the wrong type (not a Furrow frame?)");
+  return m->value();
+}
+
+// Marks the grid's active voxels in f.active and hands each (cell, value) to `store`.
+template <class GridT, class Store>
+void read_grid(const GridT& grid, FieldFrame& f, const std::string& path, Store store) {
+  for (auto it = grid.cbeginValueOn(); it; ++it) {
+    if (!it.isVoxelValue())
+      throw std::runtime_error("read_frame: " + path + ": grid '" + grid.getName() + "' has an active tile");
+    const openvdb::Coord xyz = it.getCoord();
+    if (xyz.z() != 0 || xyz.x() < 0 || xyz.x() >= f.nx || xyz.y() < 0 || xyz.y() >= f.ny)
+      throw std::runtime_error("read_frame: " + path + ": grid '" + grid.getName() +
+                               "' has a voxel outside the " + std::to_string(f.nx) + "x" +
+                               std::to_string(f.ny) + "x1 frame");
+    const size_t c = f.index(xyz.x(), xyz.y());
+    f.active[c] = 1;
+    store(c, *it);
+  }
+}
+
+}  // namespace
+
+FieldFrame read_frame(const std::string& vdb_path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(vdb_path, ec))
+    throw std::runtime_error("read_frame: no such file " + vdb_path);
+  init_openvdb();
+  openvdb::MetaMap::Ptr meta;
+  openvdb::GridPtrVecPtr grids;
+  try {
+    openvdb::io::File file(vdb_path);
+    file.open(false);  // read everything now: the file may be replaced while we hold the frame
+    meta = file.getMetadata();
+    grids = file.getGrids();
+    file.close();
+  } catch (const std::exception& e) {
+    throw std::runtime_error("read_frame: " + vdb_path + ": not a readable OpenVDB file (" + e.what() + ")");
+  }
+
+  FieldFrame f;
+  f.scene_name = file_meta<std::string>(*meta, "scene", vdb_path);
+  f.time_s = file_meta<double>(*meta, "time_s", vdb_path);
+  f.step = file_meta<int64_t>(*meta, "step", vdb_path);
+  f.dt_s = file_meta<double>(*meta, "dt_s", vdb_path);
+  f.dx_m = file_meta<double>(*meta, "dx_m", vdb_path);
+  f.nx = file_meta<int32_t>(*meta, "nx", vdb_path);
+  f.ny = file_meta<int32_t>(*meta, "ny", vdb_path);
+  f.origin_m = {file_meta<double>(*meta, "origin_x_m", vdb_path), file_meta<double>(*meta, "origin_y_m", vdb_path)};
+  if (f.nx <= 0 || f.ny <= 0 || !(f.dx_m > 0.0))
+    throw std::runtime_error("read_frame: " + vdb_path + ": metadata nx, ny, dx_m must be positive");
+  try {
+    f.bodies = bodies_from_json(nlohmann::json::parse(file_meta<std::string>(*meta, "bodies_json", vdb_path)));
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error("read_frame: " + vdb_path + ": metadata 'bodies_json' is malformed: " + e.what());
+  }
+
+  const size_t n = size_t(f.nx) * size_t(f.ny);
+  f.active.assign(n, 0);
+  for (const auto& base : *grids) {
+    const std::string name = base->getName();
+    const FieldInfo* info = find_field(name);
+    if (!info || base->getMetadata<openvdb::StringMetadata>(kCopyOfKey)) continue;  // alias or foreign
+    if (info->vector) {
+      auto grid = openvdb::GridBase::grid<openvdb::Vec3SGrid>(base);
+      if (!grid) throw std::runtime_error("read_frame: " + vdb_path + ": grid '" + name + "' is not a Vec3SGrid");
+      f.velocity_x.assign(n, 0.0f);
+      f.velocity_y.assign(n, 0.0f);
+      read_grid(*grid, f, vdb_path, [&](size_t c, const openvdb::Vec3s& v) {
+        f.velocity_x[c] = v.x();
+        f.velocity_y[c] = v.y();
+      });
+    } else {
+      auto grid = openvdb::GridBase::grid<openvdb::FloatGrid>(base);
+      if (!grid) throw std::runtime_error("read_frame: " + vdb_path + ": grid '" + name + "' is not a FloatGrid");
+      auto& values = f.scalars[name];
+      values.assign(n, 0.0f);
+      read_grid(*grid, f, vdb_path, [&](size_t c, float v) { values[c] = v; });
+    }
+  }
+  return f;
+}
+
+}  // namespace furrow
