@@ -94,6 +94,9 @@ struct Solver {
   ShapeFunction shape_function = ShapeFunction::Quadratic;
   int particles_per_cell_1d = 2;   // 2 -> 4 particles per cell
   double cfl = 0.4;
+  // FLIP share of the particle velocity update (0 = pure APIC). APIC alone damps non-affine
+  // motion once per step, a viscosity ~ dx^2/dt that grows as dt shrinks.
+  double flip_blend = 0.99;
   double end_time_s = 1.0;
   double end_displacement_m = -1.0;  // stop when the first moving body has travelled this far (> 0)
   int threads = 0;                   // 0: all hardware threads

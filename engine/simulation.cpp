@@ -49,6 +49,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   const size_t nodes = size_t(g_.NX) * g_.NY;
   g_.mass.assign(nodes, 0.0);
   g_.vx.assign(nodes, 0.0);
+  g_.vx0.assign(nodes, 0.0);
+  g_.vy0.assign(nodes, 0.0);
   g_.vy.assign(nodes, 0.0);
 
   bool any_dpm = false;
@@ -69,19 +71,16 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   }
   seed_beds();
 
+  flip_ = scene_.solver.flip_blend > 0.0;
+  auto pick = [&](auto kernel) {
+    using K = decltype(kernel);
+    p2g_ = flip_ ? &Simulation::particles_to_grid<K, true> : &Simulation::particles_to_grid<K, false>;
+    g2p_ = flip_ ? &Simulation::grid_to_particles<K, true> : &Simulation::grid_to_particles<K, false>;
+  };
   switch (scene_.solver.shape_function) {
-    case ShapeFunction::Linear:
-      p2g_ = &Simulation::particles_to_grid<LinearKernel>;
-      g2p_ = &Simulation::grid_to_particles<LinearKernel>;
-      break;
-    case ShapeFunction::Quadratic:
-      p2g_ = &Simulation::particles_to_grid<QuadraticKernel>;
-      g2p_ = &Simulation::grid_to_particles<QuadraticKernel>;
-      break;
-    case ShapeFunction::Cubic:
-      p2g_ = &Simulation::particles_to_grid<CubicKernel>;
-      g2p_ = &Simulation::grid_to_particles<CubicKernel>;
-      break;
+    case ShapeFunction::Linear: pick(LinearKernel{}); break;
+    case ShapeFunction::Quadratic: pick(QuadraticKernel{}); break;
+    case ShapeFunction::Cubic: pick(CubicKernel{}); break;
   }
   constitutive_ = dilatancy_ ? &Simulation::constitutive_update<true> : &Simulation::constitutive_update<false>;
   const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
@@ -184,6 +183,10 @@ void Simulation::clear_grid() {
     std::fill(g_.mass.begin() + r.begin(), g_.mass.begin() + r.end(), 0.0);
     std::fill(g_.vx.begin() + r.begin(), g_.vx.begin() + r.end(), 0.0);
     std::fill(g_.vy.begin() + r.begin(), g_.vy.begin() + r.end(), 0.0);
+    if (flip_) {
+      std::fill(g_.vx0.begin() + r.begin(), g_.vx0.begin() + r.end(), 0.0);
+      std::fill(g_.vy0.begin() + r.begin(), g_.vy0.begin() + r.end(), 0.0);
+    }
   });
 }
 
@@ -205,13 +208,16 @@ void Simulation::sort_particles() {
   for (size_t i = 0; i < n; ++i) order_[fill[scratch_u32_[i]]++] = uint32_t(i);
 }
 
-template <class K>
+template <class K, bool Flip>
 void Simulation::particles_to_grid() {
   const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
   const double Dinv = K::inv_D(inv_dx);
   double* gm = g_.mass.data();
   double* gx = g_.vx.data();
   double* gy = g_.vy.data();
+  // with FLIP the internal-force impulse is kept apart so the pre-force velocity is known
+  double* ix = Flip ? g_.vx0.data() : g_.vx.data();
+  double* iy = Flip ? g_.vy0.data() : g_.vy.data();
   const auto& P = p_;
   auto scatter_strip = [&](int s) {
     for (uint32_t k = strip_start_[s]; k < strip_start_[s + 1]; ++k) {
@@ -231,21 +237,22 @@ void Simulation::particles_to_grid() {
           const size_t node = row + a;
           const double dxp = (bx + a) * dx - xp;
           const double w = wx[a] * wy[b];
-          double fx, fy;
+          double fx, fy;  // internal-force impulse
           if constexpr (K::mls) {
-            // MLS: grad w ~ w D^-1 (x_i - x_p); stress and APIC terms share one affine matrix
-            const double q00 = m * c00 - dt * V * Dinv * sxx, q01 = m * c01 - dt * V * Dinv * sxy;
-            const double q10 = m * c10 - dt * V * Dinv * sxy, q11 = m * c11 - dt * V * Dinv * syy;
-            fx = w * (mvx + q00 * dxp + q01 * dyp);
-            fy = w * (mvy + q10 * dxp + q11 * dyp);
+            // MLS: grad w ~ w D^-1 (x_i - x_p)
+            const double k = -dt * V * Dinv * w;
+            fx = k * (sxx * dxp + sxy * dyp);
+            fy = k * (sxy * dxp + syy * dyp);
           } else {
             const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
-            fx = w * (mvx + m * (c00 * dxp + c01 * dyp)) - dt * V * (sxx * gxw + sxy * gyw);
-            fy = w * (mvy + m * (c10 * dxp + c11 * dyp)) - dt * V * (sxy * gxw + syy * gyw);
+            fx = -dt * V * (sxx * gxw + sxy * gyw);
+            fy = -dt * V * (sxy * gxw + syy * gyw);
           }
           gm[node] += w * m;
-          gx[node] += fx;
-          gy[node] += fy;
+          gx[node] += w * (mvx + m * (c00 * dxp + c01 * dyp));
+          gy[node] += w * (mvy + m * (c10 * dxp + c11 * dyp));
+          ix[node] += fx;
+          iy[node] += fy;
         }
       }
     }
@@ -257,14 +264,25 @@ void Simulation::particles_to_grid() {
 
 void Simulation::grid_update() {
   const double dt = dt_s_, gx = gravity_.x() * dt, gy = gravity_.y() * dt;
+  const bool flip = flip_;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.mass.size(), 1 << 14), [&](const auto& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const double m = g_.mass[k];
       if (m > 0.0) {
-        g_.vx[k] = g_.vx[k] / m + gx;
-        g_.vy[k] = g_.vy[k] / m + gy;
+        if (flip) {
+          // vx0 held the force impulse; it becomes the pre-force velocity
+          const double v0x = g_.vx[k] / m, v0y = g_.vy[k] / m;
+          g_.vx[k] = v0x + g_.vx0[k] / m + gx;
+          g_.vy[k] = v0y + g_.vy0[k] / m + gy;
+          g_.vx0[k] = v0x;
+          g_.vy0[k] = v0y;
+        } else {
+          g_.vx[k] = g_.vx[k] / m + gx;
+          g_.vy[k] = g_.vy[k] / m + gy;
+        }
       } else {
         g_.vx[k] = g_.vy[k] = 0.0;
+        if (flip) g_.vx0[k] = g_.vy0[k] = 0.0;
       }
     }
   });
@@ -345,9 +363,9 @@ void Simulation::bodies_and_walls() {
   wall(scene_.walls.top, 3, -P, nx + P, ny, ny + P, Vec2(0, -1));
 }
 
-template <class K>
+template <class K, bool Flip>
 void Simulation::grid_to_particles() {
-  const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
+  const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_, alpha = scene_.solver.flip_blend;
   const double Dinv = K::inv_D(inv_dx);
   const double xmax = scene_.domain.width_m, ymax = scene_.domain.height_m;
   const size_t nb = bodies_.size();
@@ -365,7 +383,7 @@ void Simulation::grid_to_particles() {
       const double xp = P.x[p], yp = P.y[p];
       const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
       const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
-      double vx = 0, vy = 0, b00 = 0, b01 = 0, b10 = 0, b11 = 0;
+      double vx = 0, vy = 0, b00 = 0, b01 = 0, b10 = 0, b11 = 0, ox = 0, oy = 0;
       for (int b = 0; b < K::N; ++b) {
         const size_t row = g_.index(bx, by + b);
         const double dyp = (by + b) * dx - yp;
@@ -375,6 +393,10 @@ void Simulation::grid_to_particles() {
           const double gvx = g_.vx[node], gvy = g_.vy[node];
           vx += w * gvx;
           vy += w * gvy;
+          if constexpr (Flip) {
+            ox += w * g_.vx0[node];
+            oy += w * g_.vy0[node];
+          }
           if constexpr (K::mls) {
             const double dxp = (bx + a) * dx - xp;
             b00 += w * gvx * dxp;
@@ -395,7 +417,9 @@ void Simulation::grid_to_particles() {
       P.c01[p] = b01 * sc;
       P.c10[p] = b10 * sc;
       P.c11[p] = b11 * sc;
+      // positions move with the grid velocity; FLIP keeps part of the particle's own velocity
       Vec2 x(xp + dt * vx, yp + dt * vy), v(vx, vy);
+      if constexpr (Flip) v += alpha * Vec2(P.vx[p] - ox, P.vy[p] - oy);
       // safety net: a particle that still ended inside a body is put back on its surface; the
       // impulse that removes its approach velocity counts in the body's force
       for (size_t b = 0; b < nb; ++b) {

@@ -35,6 +35,7 @@ struct Grid {
   int NX = 0, NY = 0;      // nodes including padding
   double dx = 0.0;
   std::vector<double> mass, vx, vy;  // momentum during transfer, velocity after grid_update
+  std::vector<double> vx0, vy0;      // FLIP only: force impulse in P2G, pre-force velocity after
   size_t index(int i, int j) const { return size_t(j + kPad) * NX + size_t(i + kPad); }
   double node_x(size_t k) const { return (int(k % NX) - kPad) * dx; }
   double node_y(size_t k) const { return (int(k / NX) - kPad) * dx; }
@@ -90,10 +91,10 @@ class Simulation {
   void seed_beds();
   void clear_grid();
   void sort_particles();
-  template <class Kernel> void particles_to_grid();
+  template <class Kernel, bool Flip> void particles_to_grid();
   void grid_update();
   void bodies_and_walls();
-  template <class Kernel> void grid_to_particles();
+  template <class Kernel, bool Flip> void grid_to_particles();
   template <bool Dilatancy> void constitutive_update();
   void advance_bodies();
   void reorder_particles();
@@ -109,6 +110,7 @@ class Simulation {
   StepStats stats_;
   Vec2 gravity_{0, 0};
   bool dilatancy_ = false;
+  bool flip_ = false;
   // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
   static constexpr int kStripCells = 4;
   std::vector<uint32_t> order_, strip_start_;
