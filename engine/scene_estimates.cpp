@@ -1,0 +1,168 @@
+// Cost estimates and prescribed body kinematics, shared by scene validation and the solver.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/scene_io.hpp"
+
+namespace furrow {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}
+
+double wave_speed_m_s(const Material& m) {
+  const double E = m.youngs_modulus_Pa, nu = m.poisson_ratio;
+  const double K = E / (3.0 * (1.0 - 2.0 * nu));
+  const double G = E / (2.0 * (1.0 + nu));
+  return std::sqrt((K + 4.0 * G / 3.0) / (m.grain_density_kg_m3 * m.phi_c));
+}
+
+double estimate_time_step_s(const Scene& scene) {
+  double c_max = 0.0;
+  for (const auto& m : scene.materials) c_max = std::max(c_max, wave_speed_m_s(m));
+  double v_max = 0.0;
+  for (const auto& b : scene.bodies) v_max = std::max(v_max, motion_max_speed_m_s(b.motion));
+  const double speed = c_max + v_max;
+  // the fastest material bounds dt, i.e. dt minimised over materials
+  return speed > 0.0 ? scene.solver.cfl * scene.domain.dx_m / speed : kInf;
+}
+
+size_t estimate_particle_count(const Scene& scene) {
+  const double dx = scene.domain.dx_m;
+  const double ppc = scene.solver.particles_per_cell_1d;
+  double n = 0.0;
+  for (const auto& bed : scene.beds) {
+    const Vec2 extent = (bed.max_m - bed.min_m).cwiseMax(0.0);
+    n += extent.x() * extent.y() / (dx * dx) * ppc * ppc;
+  }
+  // clamp before converting: a wild dx must not make the cast undefined
+  if (!(n < 1e18)) return size_t(1e18);
+  return size_t(std::llround(n));
+}
+
+double estimate_end_time_s(const Scene& scene) {
+  double t = scene.solver.end_time_s;
+  const int ref = reference_body_index(scene);
+  if (scene.solver.end_displacement_m > 0.0 && ref >= 0)
+    t = std::min(t, time_to_displacement_s(scene.bodies[size_t(ref)].motion,
+                                           scene.solver.end_displacement_m, t));
+  return t;
+}
+
+int64_t estimate_step_count(const Scene& scene) {
+  const double dt = estimate_time_step_s(scene);
+  const double steps = std::ceil(estimate_end_time_s(scene) / dt);
+  if (!(steps < 9e18)) return std::numeric_limits<int64_t>::max();
+  return int64_t(std::max(steps, 0.0));
+}
+
+Vec2 motion_velocity_m_s(const Motion& motion, double t_s) {
+  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty()) return motion.velocity_m_s;
+  const auto& k = motion.path;
+  if (t_s <= k.front().t_s) return k.front().velocity_m_s;
+  if (t_s >= k.back().t_s) return k.back().velocity_m_s;
+  auto hi = std::upper_bound(k.begin(), k.end(), t_s,
+                             [](double t, const Motion::Knot& knot) { return t < knot.t_s; });
+  auto lo = hi - 1;
+  const double a = (t_s - lo->t_s) / (hi->t_s - lo->t_s);
+  return (1.0 - a) * lo->velocity_m_s + a * hi->velocity_m_s;
+}
+
+Vec2 motion_displacement_m(const Motion& motion, double t_s) {
+  if (t_s <= 0.0) return Vec2::Zero();
+  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty())
+    return motion.velocity_m_s * t_s;
+  // trapezoids are exact for a velocity linear between knots
+  Vec2 d = Vec2::Zero();
+  double t_prev = 0.0;
+  Vec2 v_prev = motion_velocity_m_s(motion, 0.0);
+  for (const auto& knot : motion.path) {
+    if (knot.t_s <= t_prev) continue;
+    const double t_next = std::min(knot.t_s, t_s);
+    const Vec2 v_next = motion_velocity_m_s(motion, t_next);
+    d += 0.5 * (v_prev + v_next) * (t_next - t_prev);
+    t_prev = t_next;
+    v_prev = v_next;
+    if (t_prev >= t_s) return d;
+  }
+  return d + motion.path.back().velocity_m_s * (t_s - t_prev);
+}
+
+double motion_max_speed_m_s(const Motion& motion) {
+  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty())
+    return motion.velocity_m_s.norm();
+  double v = 0.0;  // |v| of a linear interpolation peaks at a knot
+  for (const auto& k : motion.path) v = std::max(v, k.velocity_m_s.norm());
+  return v;
+}
+
+int reference_body_index(const Scene& scene) {
+  for (size_t i = 0; i < scene.bodies.size(); ++i)
+    if (motion_max_speed_m_s(scene.bodies[i].motion) > 0.0) return int(i);
+  return -1;
+}
+
+double time_to_displacement_s(const Motion& motion, double distance_m, double t_max_s) {
+  if (distance_m <= 0.0) return 0.0;
+  if (!(t_max_s > 0.0)) return kInf;
+  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty()) {
+    const double v = motion.velocity_m_s.norm();
+    const double t = v > 0.0 ? distance_m / v : kInf;
+    return t <= t_max_s ? t : kInf;
+  }
+  // Piecewise-quadratic position: sample each knot interval, then bisect the first crossing.
+  std::vector<double> breaks{0.0};
+  for (const auto& k : motion.path)
+    if (k.t_s > 0.0 && k.t_s < t_max_s) breaks.push_back(k.t_s);
+  breaks.push_back(t_max_s);
+  auto reached = [&](double t) { return motion_displacement_m(motion, t).norm() >= distance_m; };
+  constexpr int kSamples = 64;
+  for (size_t s = 0; s + 1 < breaks.size(); ++s) {
+    double prev = breaks[s];
+    for (int i = 1; i <= kSamples; ++i) {
+      const double t = breaks[s] + (breaks[s + 1] - breaks[s]) * i / kSamples;
+      if (reached(t)) {
+        double lo = prev, hi = t;
+        for (int it = 0; it < 60; ++it) {
+          const double mid = 0.5 * (lo + hi);
+          (reached(mid) ? hi : lo) = mid;
+        }
+        return hi;
+      }
+      prev = t;
+    }
+  }
+  return kInf;
+}
+
+std::pair<Vec2, Vec2> shape_bounds_m(const Shape& shape) {
+  Vec2 lo = Vec2::Constant(kInf), hi = Vec2::Constant(-kInf);
+  switch (shape.kind) {
+    case Shape::Kind::Circle:
+      lo = Vec2::Constant(-shape.radius_m);
+      hi = Vec2::Constant(shape.radius_m);
+      break;
+    case Shape::Kind::Box:
+      lo = -0.5 * shape.size_m;
+      hi = 0.5 * shape.size_m;
+      break;
+    case Shape::Kind::Polygon:
+      for (const auto& v : shape.vertices_m) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+      }
+      break;
+    case Shape::Kind::Union:
+      for (const auto& part : shape.parts) {
+        auto [plo, phi] = shape_bounds_m(part);
+        lo = lo.cwiseMin(plo);
+        hi = hi.cwiseMax(phi);
+      }
+      break;
+  }
+  if (lo.x() > hi.x()) return {Vec2::Zero(), Vec2::Zero()};  // empty polygon / union
+  return {lo + shape.offset_m, hi + shape.offset_m};
+}
+
+}  // namespace furrow

@@ -1,0 +1,1416 @@
+// Scene JSON reading, validation, resolved output and `--set` overrides.
+// Each object declares its keys once (the k*Keys lists); the reader rejects any other key with its
+// JSON pointer and the nearest valid key, and checks that every declared key was looked at.
+#include "engine/scene_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "engine/fields.hpp"
+
+namespace furrow {
+
+using json = nlohmann::json;
+using KeyList = std::vector<std::string>;
+
+// ---------------------------------------------------------------------------------------------
+// errors
+
+static std::string format_error(const SceneError& e) {
+  std::ostringstream os;
+  os << e.file;
+  if (e.line > 0)
+    os << ":" << e.line << ":" << e.column << " (byte " << e.byte << ")";
+  else
+    os << ": " << (e.path.empty() ? "/" : e.path);
+  os << ": got " << e.value << ", expected " << e.expected;
+  if (!e.note.empty()) os << " (" << e.note << ")";
+  return os.str();
+}
+
+SceneError::SceneError(std::string file_, std::string path_, std::string value_,
+                       std::string expected_, std::string note_, int line_, int column_,
+                       size_t byte_)
+    : std::runtime_error(""), file(std::move(file_)), path(std::move(path_)),
+      value(std::move(value_)), expected(std::move(expected_)), note(std::move(note_)),
+      line(line_), column(column_), byte(byte_) {
+  static_cast<std::runtime_error&>(*this) = std::runtime_error(format_error(*this));
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMaxDepth = 64;
+constexpr size_t kMaxListItems = 10000;  // knots, vertices, bodies...: keeps validation bounded
+
+// A short, always-printable dump of a value for messages.
+std::string short_dump(const json& v) {
+  std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+// Shortest text that reads back as the same double ("0", "0.3", "1e-05").
+std::string num_str(double x) {
+  char buf[40];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(buf, sizeof buf, "%.*g", precision, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+std::string vec_str(const Vec2& v) { return "[" + num_str(v.x()) + ", " + num_str(v.y()) + "]"; }
+
+std::string escape_pointer_token(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+std::string join(const KeyList& keys, const std::string& sep = ", ") {
+  std::string s;
+  for (size_t i = 0; i < keys.size(); ++i) s += (i ? sep : "") + keys[i];
+  return s;
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      const bool same = std::tolower((unsigned char)a[i - 1]) == std::tolower((unsigned char)b[j - 1]);
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (same ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// " (did you mean "x"?)" when a candidate is close enough to be a plausible typo.
+std::string suggestion(const std::string& got, const KeyList& candidates) {
+  std::string best;
+  size_t best_d = std::numeric_limits<size_t>::max();
+  for (const auto& c : candidates) {
+    const size_t d = edit_distance(got, c);
+    if (d < best_d) best_d = d, best = c;
+  }
+  if (best.empty() || got.size() > 200) return "";
+  const size_t limit = std::max<size_t>(2, std::min(got.size(), best.size()) / 3);
+  if (best_d <= limit) return " (did you mean \"" + best + "\"?)";
+  return "";
+}
+
+std::string one_of(const KeyList& names) {
+  KeyList q;
+  for (const auto& n : names) q.push_back("\"" + n + "\"");
+  return q.size() == 1 ? q[0] : "one of " + join(q);
+}
+
+// ---------------------------------------------------------------------------------------------
+// schema: the keys of every object (README order)
+
+const KeyList kRootKeys = {"schema_version", "name", "description", "domain", "solver", "materials",
+                           "beds", "bodies", "walls", "effects", "outputs"};
+const KeyList kDomainKeys = {"width_m", "height_m", "dx_m"};
+const KeyList kSolverKeys = {"shape_function", "particles_per_cell_1d", "cfl", "end_time_s",
+                             "end_displacement_m", "threads", "max_steps"};
+const KeyList kMaterialNdpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_s",
+                                   "youngs_modulus_Pa", "poisson_ratio"};
+const KeyList kMaterialDpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_c", "chi",
+                                  "phi_min", "youngs_modulus_Pa", "poisson_ratio"};
+const KeyList kBedKeys = {"material", "min_m", "max_m", "packing_fraction", "k0"};
+const KeyList kBodyKeys = {"name", "shape", "start_m", "motion", "friction"};
+const KeyList kBoxKeys = {"type", "size_m"};
+const KeyList kCircleKeys = {"type", "radius_m"};
+const KeyList kPolygonKeys = {"type", "vertices_m"};
+const KeyList kUnionKeys = {"type", "parts"};
+const KeyList kConstantMotionKeys = {"type", "velocity_m_s"};
+const KeyList kPathMotionKeys = {"type", "knots"};
+const KeyList kKnotKeys = {"t_s", "velocity_m_s"};
+const KeyList kWallsKeys = {"left", "right", "bottom", "top"};
+const KeyList kFrictionWallKeys = {"type", "friction"};
+const KeyList kPlainWallKeys = {"type"};
+const KeyList kEffectsKeys = {"gravity", "gravity_m_s2", "dilatancy", "separation", "body_friction",
+                              "wall_friction"};
+const KeyList kOutputsKeys = {"frame_interval_s", "fields", "movies", "force_interval_s",
+                              "average_window"};
+const KeyList kWindowKeys = {"from_s", "to_s", "from_m", "to_m"};
+
+const KeyList kModels = {"ndpm", "dpm"};  // enum orders of scene.hpp
+const KeyList kShapeTypes = {"circle", "box", "polygon", "union"};  // Shape::Kind order
+const KeyList kMotionTypes = {"constant_velocity", "path"};
+const KeyList kWallTypes = {"slip", "friction", "sticky", "open"};
+const KeyList kShapeFunctions = {"linear", "quadratic", "cubic"};
+
+KeyList merged(std::initializer_list<const KeyList*> lists) {
+  KeyList out;
+  for (const KeyList* l : lists)
+    for (const auto& k : *l)
+      if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+  return out;
+}
+
+KeyList with_offset(KeyList keys) {
+  keys.push_back("offset_m");
+  return keys;
+}
+
+// Keys for a variant object: the variant named by `tag` in `obj`, or all variants' keys.
+KeyList shape_keys(const json* obj, bool is_part) {
+  std::string type;
+  if (obj && obj->is_object() && obj->contains("type") && (*obj)["type"].is_string())
+    type = (*obj)["type"].get<std::string>();
+  KeyList k;
+  if (type == "box") k = kBoxKeys;
+  else if (type == "circle") k = kCircleKeys;
+  else if (type == "polygon") k = kPolygonKeys;
+  else if (type == "union") k = kUnionKeys;
+  else k = merged({&kBoxKeys, &kCircleKeys, &kPolygonKeys, &kUnionKeys});
+  return is_part ? with_offset(k) : k;
+}
+
+std::string variant_tag(const json* obj, const char* key) {
+  if (obj && obj->is_object() && obj->contains(key) && (*obj)[key].is_string())
+    return (*obj)[key].get<std::string>();
+  return "";
+}
+
+KeyList material_keys(const json* obj) {
+  const std::string m = variant_tag(obj, "model");
+  if (m == "ndpm") return kMaterialNdpmKeys;
+  if (m == "dpm") return kMaterialDpmKeys;
+  return merged({&kMaterialNdpmKeys, &kMaterialDpmKeys});
+}
+
+KeyList motion_keys(const json* obj) {
+  const std::string t = variant_tag(obj, "type");
+  if (t == "constant_velocity") return kConstantMotionKeys;
+  if (t == "path") return kPathMotionKeys;
+  return merged({&kConstantMotionKeys, &kPathMotionKeys});
+}
+
+KeyList wall_keys(const json* obj) {
+  const std::string t = variant_tag(obj, "type");
+  if (t == "friction") return kFrictionWallKeys;
+  if (std::find(kWallTypes.begin(), kWallTypes.end(), t) != kWallTypes.end()) return kPlainWallKeys;
+  return kFrictionWallKeys;
+}
+
+// ---------------------------------------------------------------------------------------------
+// reading
+
+struct Ctx {
+  std::string source;
+  ValidationOptions options;
+};
+
+[[noreturn]] void fail(const Ctx& c, const std::string& path, const std::string& value,
+                       const std::string& expected) {
+  throw SceneError(c.source, path, value, expected);
+}
+
+[[noreturn]] void fail(const Ctx& c, const std::string& path, const char* value,
+                       const std::string& expected) {
+  fail(c, path, std::string(value), expected);
+}
+
+[[noreturn]] void fail(const Ctx& c, const std::string& path, const json& value,
+                       const std::string& expected) {
+  fail(c, path, short_dump(value), expected);
+}
+
+// One JSON object being consumed: unknown keys are rejected on construction, and finish()
+// checks that the code looked at every key it declared (schema and reader cannot drift apart).
+class Obj {
+ public:
+  Obj(const Ctx& c, const json& j, std::string path, KeyList keys,
+      std::map<std::string, std::string> hints = {}, const std::string& what = "an object")
+      : c_(c), j_(j), path_(std::move(path)), keys_(std::move(keys)) {
+    if (!j.is_object()) fail(c, display(), j, what + " {" + join(keys_) + "}");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (std::find(keys_.begin(), keys_.end(), it.key()) != keys_.end()) continue;
+      const std::string at = path_ + "/" + escape_pointer_token(it.key());
+      const std::string got = short_dump(json(it.key())) + ": " + short_dump(it.value());
+      if (auto h = hints.find(it.key()); h != hints.end()) fail(c, at, got, h->second);
+      fail(c, at, got,
+           "a key of " + display() + suggestion(it.key(), keys_) + "; keys here: " + join(keys_));
+    }
+  }
+
+  const json* opt(const std::string& key) {
+    used_.insert(key);
+    auto it = j_.find(key);
+    return it == j_.end() ? nullptr : &*it;
+  }
+  const json& req(const std::string& key, const std::string& expected) {
+    const json* v = opt(key);
+    if (!v) fail(c_, at(key), "(missing)", expected);
+    return *v;
+  }
+  std::string at(const std::string& key) const { return path_ + "/" + key; }
+  const std::string& path() const { return path_; }
+  const Ctx& ctx() const { return c_; }
+  void finish() const {
+    for (const auto& k : keys_)
+      if (!used_.count(k)) throw std::logic_error("scene reader never read declared key " + at(k));
+  }
+
+ private:
+  std::string display() const { return path_.empty() ? "/" : path_; }
+  const Ctx& c_;
+  const json& j_;
+  std::string path_;
+  KeyList keys_;
+  std::set<std::string> used_;
+};
+
+// Accepted number ranges; the expectation text is generated from them.
+struct Range {
+  double lo = -kInf, hi = kInf;
+  bool lo_open = false, hi_open = false;
+  bool contains(double x) const {
+    return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+  }
+  std::string text(const std::string& unit) const {
+    std::string s;
+    if (lo == -kInf && hi == kInf) s = "a finite number";
+    else if (hi == kInf) s = std::string("a number ") + (lo_open ? "> " : ">= ") + num_str(lo);
+    else if (lo == -kInf) s = std::string("a number ") + (hi_open ? "< " : "<= ") + num_str(hi);
+    else
+      s = std::string("a number in ") + (lo_open ? "(" : "[") + num_str(lo) + ", " + num_str(hi) +
+          (hi_open ? ")" : "]");
+    if (!unit.empty()) s += " (" + unit + ")";
+    return s;
+  }
+};
+const Range kAny{};
+const Range kPositive{0.0, kInf, true, false};
+const Range kNonNegative{0.0, kInf, false, false};
+Range open(double a, double b) { return {a, b, true, true}; }
+Range closed(double a, double b) { return {a, b, false, false}; }
+Range half_open(double a, double b) { return {a, b, false, true}; }
+const Range kFriction = closed(0.0, 5.0);
+const Range kPacking = open(0.3, 0.75);
+
+double as_number(const Ctx& c, const json& v, const std::string& path, const Range& r,
+                 const std::string& unit, const std::string& why = "") {
+  const std::string expected = r.text(unit) + why;
+  if (!v.is_number()) fail(c, path, v, expected);
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) fail(c, path, v, "a finite number" + (unit.empty() ? "" : " (" + unit + ")"));
+  if (!r.contains(x)) fail(c, path, v, expected);
+  return x;
+}
+
+double num(Obj& o, const std::string& key, const Range& r, const std::string& unit,
+           std::optional<double> def = std::nullopt, const std::string& why = "") {
+  const json* v = def ? o.opt(key) : &o.req(key, r.text(unit) + why);
+  if (!v) return *def;
+  return as_number(o.ctx(), *v, o.at(key), r, unit, why);
+}
+
+int64_t as_integer(const Ctx& c, const json& v, const std::string& path, int64_t lo, int64_t hi) {
+  const std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!v.is_number()) fail(c, path, v, expected);
+  const double x = v.get<double>();
+  if (!(x >= double(lo) && x <= double(hi)) || std::floor(x) != x) fail(c, path, v, expected);
+  return int64_t(x);
+}
+
+int64_t integer(Obj& o, const std::string& key, int64_t lo, int64_t hi, std::optional<int64_t> def) {
+  const std::string expected = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const json* v = def ? o.opt(key) : &o.req(key, expected);
+  if (!v) return *def;
+  return as_integer(o.ctx(), *v, o.at(key), lo, hi);
+}
+
+bool boolean(Obj& o, const std::string& key, bool def) {
+  const json* v = o.opt(key);
+  if (!v) return def;
+  if (!v->is_boolean()) fail(o.ctx(), o.at(key), *v, "true or false");
+  return v->get<bool>();
+}
+
+std::string as_string(const Ctx& c, const json& v, const std::string& path, const std::string& expected) {
+  if (!v.is_string()) fail(c, path, v, expected);
+  std::string s = v.get<std::string>();
+  try {
+    (void)json(s).dump();  // strings set from the command line may not be UTF-8
+  } catch (const json::exception&) {
+    fail(c, path, v, expected + " (valid UTF-8)");
+  }
+  return s;
+}
+
+bool valid_name(const std::string& s) {
+  if (s.empty() || s.size() > 64 || s[0] == '.' || s[0] == '-') return false;
+  for (char ch : s)
+    if (!(std::isalnum((unsigned char)ch) || ch == '_' || ch == '-' || ch == '.')) return false;
+  return true;
+}
+const char* kNameRule = "a name of 1-64 characters from A-Z a-z 0-9 _ - . (not starting with . or -)";
+
+std::string name_value(Obj& o, const std::string& key, std::optional<std::string> def = std::nullopt) {
+  const json* v = def ? o.opt(key) : &o.req(key, kNameRule);
+  if (!v) return *def;
+  std::string s = as_string(o.ctx(), *v, o.at(key), kNameRule);
+  if (!valid_name(s)) fail(o.ctx(), o.at(key), *v, kNameRule);
+  return s;
+}
+
+// Index into `names` of the string at `key` (required unless def >= 0).
+int choice(Obj& o, const std::string& key, const KeyList& names, int def = -1) {
+  const json* v = def >= 0 ? o.opt(key) : &o.req(key, one_of(names));
+  if (!v) return def;
+  if (!v->is_string()) fail(o.ctx(), o.at(key), *v, one_of(names));
+  const std::string s = v->get<std::string>();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == s) return int(i);
+  fail(o.ctx(), o.at(key), *v, one_of(names) + suggestion(s, names));
+}
+
+Vec2 as_vec2(const Ctx& c, const json& v, const std::string& path, const Range& r,
+             const std::string& unit) {
+  const std::string expected = "[x, y], two numbers" +
+                               (r.lo == -kInf && r.hi == kInf ? std::string(" (") + unit + ")"
+                                                              : ", each " + r.text(unit));
+  if (!v.is_array() || v.size() != 2) fail(c, path, v, expected);
+  Vec2 out;
+  for (int i = 0; i < 2; ++i) {
+    const std::string p = path + "/" + std::to_string(i);
+    if (!v[size_t(i)].is_number()) fail(c, p, v[size_t(i)], expected);
+    out[i] = as_number(c, v[size_t(i)], p, r, unit);
+  }
+  return out;
+}
+
+Vec2 vec2(Obj& o, const std::string& key, const Range& r, const std::string& unit,
+          std::optional<Vec2> def = std::nullopt) {
+  const json* v = def ? o.opt(key) : &o.req(key, "[x, y], two numbers (" + unit + ")");
+  if (!v) return *def;
+  return as_vec2(o.ctx(), *v, o.at(key), r, unit);
+}
+
+const json& array(Obj& o, const std::string& key, const std::string& what, bool required,
+                  size_t min_items) {
+  static const json empty = json::array();
+  const std::string expected = "an array of " + what +
+                               (min_items ? " (at least " + std::to_string(min_items) + ")" : "");
+  const json* v = required ? &o.req(key, expected) : o.opt(key);
+  if (!v) return empty;
+  if (!v->is_array() || v->size() < min_items) fail(o.ctx(), o.at(key), *v, expected);
+  if (v->size() > kMaxListItems)
+    fail(o.ctx(), o.at(key), "an array of " + std::to_string(v->size()) + " items",
+         "at most " + std::to_string(kMaxListItems) + " " + what);
+  return *v;
+}
+
+// ---------------------------------------------------------------------------------------------
+// sections
+
+Domain read_domain(const Ctx& c, const json& j) {
+  Obj o(c, j, "/domain", kDomainKeys);
+  Domain d;
+  d.width_m = num(o, "width_m", kPositive, "m");
+  d.height_m = num(o, "height_m", kPositive, "m");
+  d.dx_m = num(o, "dx_m", kPositive, "m", std::nullopt, ", the grid cell size");
+  o.finish();
+  return d;
+}
+
+Solver read_solver(const Ctx& c, const json& j) {
+  Obj o(c, j, "/solver", kSolverKeys);
+  Solver s;
+  s.shape_function = ShapeFunction(choice(o, "shape_function", kShapeFunctions, 1));
+  s.particles_per_cell_1d = int(integer(o, "particles_per_cell_1d", 1, 8, 2));
+  s.cfl = num(o, "cfl", Range{0.0, 1.0, true, false}, "", 0.4);
+  s.end_time_s = num(o, "end_time_s", kPositive, "s");
+  if (const json* v = o.opt("end_displacement_m"); v && !v->is_null())
+    s.end_displacement_m = as_number(c, *v, o.at("end_displacement_m"), kPositive, "m", ", or null for none");
+  s.threads = int(integer(o, "threads", 0, 1024, 0));
+  s.max_steps = int(integer(o, "max_steps", 1, std::numeric_limits<int>::max(), 50'000'000));
+  o.finish();
+  return s;
+}
+
+Material read_material(const Ctx& c, const json& j, const std::string& path) {
+  const std::string model = variant_tag(&j, "model");
+  const bool dpm = model == "dpm";
+  std::map<std::string, std::string> hints;
+  if (model == "ndpm") {
+    const std::string why = " (DPM-only key; this material has \"model\": \"ndpm\")";
+    hints["chi"] = "no \"chi\" on an NDPM material" + why;
+    hints["phi_min"] = "no \"phi_min\" on an NDPM material" + why;
+    hints["mu_c"] = "\"mu_s\" on an NDPM material (mu_c is the DPM name)";
+  } else if (dpm) {
+    hints["mu_s"] = "\"mu_c\" on a DPM material (its mu_s follows from phi_d: mu_c + (phi_d - phi_c) chi)";
+  }
+  Obj o(c, j, path, material_keys(&j), hints, "a material object");
+  Material m;
+  m.name = name_value(o, "name");
+  m.model = MaterialModel(choice(o, "model", kModels));
+  m.grain_density_kg_m3 = num(o, "grain_density_kg_m3", Range{0.0, 1e5, true, false}, "kg/m^3");
+  m.phi_c = num(o, "phi_c", kPacking, "");
+  if (dpm) {
+    m.mu = num(o, "mu_c", kFriction, "");
+    m.chi = num(o, "chi", closed(0.0, 100.0), "");
+    m.phi_min = num(o, "phi_min", open(0.3, m.phi_c), "", 0.45, " (below phi_c)");
+  } else {
+    m.mu = num(o, "mu_s", kFriction, "");
+  }
+  m.youngs_modulus_Pa = num(o, "youngs_modulus_Pa", kPositive, "Pa", 5.0e6);
+  m.poisson_ratio = num(o, "poisson_ratio", half_open(0.0, 0.5), "", 0.3);
+  o.finish();
+  return m;
+}
+
+Bed read_bed(const Ctx& c, const json& j, const std::string& path, const Scene& s) {
+  Obj o(c, j, path, kBedKeys, {}, "a bed object");
+  Bed b;
+  KeyList names;
+  for (const auto& m : s.materials) names.push_back(m.name);
+  const json& mv = o.req("material", "the name of a material: " + one_of(names));
+  b.material = as_string(c, mv, o.at("material"), "the name of a material: " + one_of(names));
+  const Material* mat = s.find_material(b.material);
+  if (!mat) fail(c, o.at("material"), mv, "the name of a material: " + one_of(names) + suggestion(b.material, names));
+  b.min_m = vec2(o, "min_m", kAny, "m");
+  b.max_m = vec2(o, "max_m", kAny, "m");
+  const Range packing = mat->model == MaterialModel::DPM ? Range{mat->phi_min, 0.75, false, true} : kPacking;
+  b.packing_fraction = num(o, "packing_fraction", packing, "", mat->phi_c,
+                           mat->model == MaterialModel::DPM ? " (at least the material's phi_min)" : "");
+  if (const json* k0 = o.opt("k0")) {
+    const std::string expected = "\"jaky\" or a number in (0, 3]";
+    if (k0->is_string()) {
+      if (k0->get<std::string>() != "jaky") fail(c, o.at("k0"), *k0, expected);
+      b.k0 = -1.0;
+    } else {
+      b.k0 = as_number(c, *k0, o.at("k0"), Range{0.0, 3.0, true, false}, "", " or \"jaky\"");
+    }
+  }
+  o.finish();
+  return b;
+}
+
+Shape read_shape(const Ctx& c, const json& j, const std::string& path, bool is_part, int depth) {
+  std::map<std::string, std::string> hints;
+  if (!is_part) hints["offset_m"] = "no \"offset_m\" here (only union parts have one; move the body with start_m)";
+  const std::string type = variant_tag(&j, "type");
+  if (type == "box" || type == "circle" || type == "polygon" || type == "union") {
+    for (const auto& [key, t] : std::map<std::string, std::string>{
+             {"size_m", "box"}, {"radius_m", "circle"}, {"vertices_m", "polygon"}, {"parts", "union"}})
+      if (t != type) hints[key] = "no \"" + key + "\" on a " + type + " (it belongs to a " + t + ")";
+  }
+  Obj o(c, j, path, shape_keys(&j, is_part), hints, "a shape object");
+  Shape s;
+  s.kind = Shape::Kind(choice(o, "type", kShapeTypes));
+  switch (s.kind) {
+    case Shape::Kind::Box:
+      s.size_m = vec2(o, "size_m", kPositive, "m");
+      break;
+    case Shape::Kind::Circle:
+      s.radius_m = num(o, "radius_m", kPositive, "m");
+      break;
+    case Shape::Kind::Polygon: {
+      const json& vs = array(o, "vertices_m", "[x, y] vertices (m)", true, 3);
+      for (size_t i = 0; i < vs.size(); ++i)
+        s.vertices_m.push_back(as_vec2(c, vs[i], o.at("vertices_m") + "/" + std::to_string(i), kAny, "m"));
+      // convex and counter-clockwise: every turn is to the left, and the area is positive
+      const size_t n = s.vertices_m.size();
+      double area2 = 0.0;
+      for (size_t i = 0; i < n; ++i) {
+        const Vec2 a = s.vertices_m[i], b = s.vertices_m[(i + 1) % n], d = s.vertices_m[(i + 2) % n];
+        const Vec2 e1 = b - a, e2 = d - b;
+        area2 += a.x() * b.y() - b.x() * a.y();
+        if (e1.x() * e2.y() - e1.y() * e2.x() <= 0.0)
+          fail(c, o.at("vertices_m") + "/" + std::to_string((i + 1) % n), vs[(i + 1) % n],
+               "a convex polygon listed counter-clockwise (each vertex a strict left turn)");
+      }
+      if (!(area2 > 0.0)) fail(c, o.at("vertices_m"), vs, "a convex counter-clockwise polygon with area > 0");
+      break;
+    }
+    case Shape::Kind::Union: {
+      if (depth >= 4) fail(c, o.at("parts"), *o.opt("parts"), "unions nested at most 4 deep");
+      const json& ps = array(o, "parts", "shapes", true, 1);
+      for (size_t i = 0; i < ps.size(); ++i)
+        s.parts.push_back(read_shape(c, ps[i], o.at("parts") + "/" + std::to_string(i), true, depth + 1));
+      break;
+    }
+  }
+  if (is_part) s.offset_m = vec2(o, "offset_m", kAny, "m", Vec2::Zero());
+  else o.opt("offset_m");
+  o.finish();
+  return s;
+}
+
+Motion read_motion(const Ctx& c, const json& j, const std::string& path) {
+  const std::string type = variant_tag(&j, "type");
+  std::map<std::string, std::string> hints;
+  if (type == "path") hints["velocity_m_s"] = "velocities inside \"knots\" for a path motion";
+  if (type == "constant_velocity") hints["knots"] = "no \"knots\" on a constant_velocity motion (use \"type\": \"path\")";
+  Obj o(c, j, path, motion_keys(&j), hints, "a motion object");
+  Motion m;
+  m.kind = Motion::Kind(choice(o, "type", kMotionTypes));
+  if (m.kind == Motion::Kind::ConstantVelocity) {
+    m.velocity_m_s = vec2(o, "velocity_m_s", kAny, "m/s");
+  } else {
+    const json& ks = array(o, "knots", "{\"t_s\", \"velocity_m_s\"} knots", true, 1);
+    for (size_t i = 0; i < ks.size(); ++i) {
+      const std::string kp = o.at("knots") + "/" + std::to_string(i);
+      Obj k(c, ks[i], kp, kKnotKeys, {}, "a knot object");
+      Motion::Knot knot{};
+      if (i == 0) {
+        knot.t_s = num(k, "t_s", closed(0.0, 0.0), "s", std::nullopt, " (the first knot is at t = 0)");
+      } else {
+        const double prev = m.path.back().t_s;
+        knot.t_s = num(k, "t_s", Range{prev, kInf, true, false}, "s", std::nullopt, " (knot times increase)");
+      }
+      knot.velocity_m_s = vec2(k, "velocity_m_s", kAny, "m/s");
+      k.finish();
+      m.path.push_back(knot);
+    }
+    m.velocity_m_s = m.path.front().velocity_m_s;
+  }
+  o.finish();
+  return m;
+}
+
+Body read_body(const Ctx& c, const json& j, const std::string& path) {
+  Obj o(c, j, path, kBodyKeys, {}, "a body object");
+  Body b;
+  b.name = name_value(o, "name");
+  b.shape = read_shape(c, o.req("shape", "a shape object {\"type\": " + one_of(kShapeTypes) + ", ...}"),
+                       o.at("shape"), false, 0);
+  b.start_m = vec2(o, "start_m", kAny, "m");
+  if (const json* mv = o.opt("motion")) b.motion = read_motion(c, *mv, o.at("motion"));
+  b.friction = num(o, "friction", kFriction, "", 0.35);
+  o.finish();
+  return b;
+}
+
+Wall read_wall(const Ctx& c, const json* j, const std::string& path, Wall def) {
+  if (!j) return def;
+  std::map<std::string, std::string> hints;
+  const std::string type = variant_tag(j, "type");
+  if (!type.empty() && type != "friction")
+    hints["friction"] = "no \"friction\" on a " + type + " wall (use \"type\": \"friction\")";
+  Obj o(c, *j, path, wall_keys(j), hints, "a wall object");
+  Wall w;
+  w.kind = Wall::Kind(choice(o, "type", kWallTypes));
+  if (w.kind == Wall::Kind::Friction) w.friction = num(o, "friction", kFriction, "");
+  else o.opt("friction");
+  o.finish();
+  return w;
+}
+
+Walls read_walls(const Ctx& c, const json* j) {
+  Walls w;
+  if (!j) return w;
+  Obj o(c, *j, "/walls", kWallsKeys);
+  w.left = read_wall(c, o.opt("left"), o.at("left"), w.left);
+  w.right = read_wall(c, o.opt("right"), o.at("right"), w.right);
+  w.bottom = read_wall(c, o.opt("bottom"), o.at("bottom"), w.bottom);
+  w.top = read_wall(c, o.opt("top"), o.at("top"), w.top);
+  o.finish();
+  return w;
+}
+
+Effects read_effects(const Ctx& c, const json* j, const Scene& s) {
+  bool any_dpm = false;
+  for (const auto& m : s.materials) any_dpm |= m.model == MaterialModel::DPM;
+  Effects e;
+  e.dilatancy = any_dpm;
+  if (!j) return e;
+  Obj o(c, *j, "/effects", kEffectsKeys);
+  e.gravity = boolean(o, "gravity", true);
+  e.gravity_m_s2 = vec2(o, "gravity_m_s2", kAny, "m/s^2", e.gravity_m_s2);
+  e.dilatancy = boolean(o, "dilatancy", any_dpm);
+  if (e.dilatancy && !any_dpm)
+    fail(c, o.at("dilatancy"), *o.opt("dilatancy"), "false: dilatancy needs a material with \"model\": \"dpm\"");
+  e.separation = boolean(o, "separation", true);
+  e.body_friction = boolean(o, "body_friction", true);
+  e.wall_friction = boolean(o, "wall_friction", true);
+  o.finish();
+  return e;
+}
+
+KeyList field_names() {
+  KeyList names;
+  for (const auto& f : field_registry()) names.push_back(f.name);
+  return names;
+}
+
+Outputs read_outputs(const Ctx& c, const json* j, const Scene& s) {
+  Outputs out;
+  if (!j) return out;
+  Obj o(c, *j, "/outputs", kOutputsKeys);
+  out.frame_interval_s = num(o, "frame_interval_s", kNonNegative, "s", 0.0, ", 0 for no frames");
+  bool any_dpm = false;
+  for (const auto& m : s.materials) any_dpm |= m.model == MaterialModel::DPM;
+  const KeyList names = field_names();
+  const json& fields = array(o, "fields", "field names", false, 0);
+  for (size_t i = 0; i < fields.size(); ++i) {
+    const std::string p = o.at("fields") + "/" + std::to_string(i);
+    const std::string f = as_string(c, fields[i], p, "a field name: " + one_of(names));
+    const FieldInfo* info = find_field(f);
+    if (!info) fail(c, p, fields[i], "a field name: " + one_of(names) + suggestion(f, names));
+    if (info->dpm_only && !any_dpm)
+      fail(c, p, fields[i], "a field this scene has (\"" + f + "\" exists only with a DPM material)");
+    if (std::find(out.fields.begin(), out.fields.end(), f) != out.fields.end())
+      fail(c, p, fields[i], "each field listed once");
+    out.fields.push_back(f);
+  }
+  const json& movies = array(o, "movies", "field names", false, 0);
+  for (size_t i = 0; i < movies.size(); ++i) {
+    const std::string p = o.at("movies") + "/" + std::to_string(i);
+    const std::string expected = "a name listed in /outputs/fields" +
+                                 (out.fields.empty() ? std::string(" (which is empty)") : ": " + one_of(out.fields));
+    const std::string f = as_string(c, movies[i], p, expected);
+    if (std::find(out.fields.begin(), out.fields.end(), f) == out.fields.end())
+      fail(c, p, movies[i], expected + suggestion(f, out.fields));
+    if (std::find(out.movies.begin(), out.movies.end(), f) != out.movies.end())
+      fail(c, p, movies[i], "each movie listed once");
+    out.movies.push_back(f);
+  }
+  if (!out.fields.empty() && out.frame_interval_s == 0.0)
+    fail(c, o.at("frame_interval_s"), o.opt("frame_interval_s") ? short_dump(*o.opt("frame_interval_s")) : "(missing)",
+         "a number > 0 (s) when /outputs/fields lists fields");
+  out.force_interval_s = num(o, "force_interval_s", kNonNegative, "s", 0.0, ", 0 for every step");
+  if (const json* w = o.opt("average_window")) {
+    Obj a(c, *w, o.at("average_window"), kWindowKeys);
+    const bool by_time = a.opt("from_s") || a.opt("to_s");
+    const bool by_disp = a.opt("from_m") || a.opt("to_m");
+    if (by_time == by_disp)
+      fail(c, a.path(), *w, "either {\"from_s\", \"to_s\"} (time) or {\"from_m\", \"to_m\"} (body displacement)");
+    const std::string unit = by_time ? "s" : "m";
+    double from = num(a, by_time ? "from_s" : "from_m", kNonNegative, unit, 0.0);
+    double to = -1.0;
+    const std::string to_key = by_time ? "to_s" : "to_m";
+    if (const json* t = a.opt(to_key); t && !t->is_null())
+      to = as_number(c, *t, a.at(to_key), Range{from, kInf, true, false}, unit, ", or null for the end of the run");
+    (by_time ? out.average_from_s : out.average_from_m) = from;
+    (by_time ? out.average_to_s : out.average_to_m) = to;
+    a.finish();
+  }
+  o.finish();
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// checks across sections (geometry, estimates)
+
+std::string idx_path(const char* array, size_t i, const std::string& key = "") {
+  return std::string("/") + array + "/" + std::to_string(i) + (key.empty() ? "" : "/" + key);
+}
+
+// Smallest feature of a shape (circle diameter, box short side, polygon width) and its path.
+void smallest_feature(const Shape& s, const std::string& path, double& size, std::string& where) {
+  auto take = [&](double d, const std::string& p) {
+    if (d < size) size = d, where = p;
+  };
+  switch (s.kind) {
+    case Shape::Kind::Circle: take(2.0 * s.radius_m, path + "/radius_m"); break;
+    case Shape::Kind::Box: take(s.size_m.minCoeff(), path + "/size_m"); break;
+    case Shape::Kind::Polygon: {
+      // width of a convex polygon: the smallest extent across its edge normals
+      const auto& v = s.vertices_m;
+      double w = kInf;
+      for (size_t i = 0; i < v.size(); ++i) {
+        const Vec2 e = v[(i + 1) % v.size()] - v[i];
+        const Vec2 n = Vec2(-e.y(), e.x()).normalized();
+        double lo = kInf, hi = -kInf;
+        for (const auto& p : v) lo = std::min(lo, n.dot(p)), hi = std::max(hi, n.dot(p));
+        w = std::min(w, hi - lo);
+      }
+      take(w, path + "/vertices_m");
+      break;
+    }
+    case Shape::Kind::Union:
+      for (size_t i = 0; i < s.parts.size(); ++i) smallest_feature(s.parts[i], path + "/parts/" + std::to_string(i), size, where);
+      break;
+  }
+}
+
+// Why a body with bounds [lo, hi] at some time is not allowed there; "" if it is.
+std::string wall_problem(const Scene& s, const Vec2& lo, const Vec2& hi) {
+  const double W = s.domain.width_m, H = s.domain.height_m, dx = s.domain.dx_m;
+  const double tol = 1e-9 * std::max(W, H);
+  struct Side { const char* name; const Wall& wall; double clearance; };
+  const Side sides[] = {{"left", s.walls.left, lo.x()}, {"right", s.walls.right, W - hi.x()},
+                        {"bottom", s.walls.bottom, lo.y()}, {"top", s.walls.top, H - hi.y()}};
+  for (const auto& side : sides)
+    if (side.clearance < -tol) return std::string("it crosses the ") + side.name + " edge of the domain";
+  for (const auto& side : sides)
+    if (side.wall.kind != Wall::Kind::Open && side.clearance < dx - tol)
+      return std::string("it overlaps the ") + side.name + " wall: clearance " + num_str(side.clearance) +
+             " m is less than one cell (dx_m = " + num_str(dx) + ")";
+  return "";
+}
+
+void check_scene(const Ctx& c, const Scene& s) {
+  const double W = s.domain.width_m, H = s.domain.height_m, dx = s.domain.dx_m;
+  const double tol = 1e-9 * std::max(W, H);
+
+  if (dx > 0.25 * std::min(W, H))
+    fail(c, "/domain/dx_m", num_str(dx), "at most a quarter of the domain's smaller side (" +
+                                             num_str(0.25 * std::min(W, H)) + " m)");
+  const double nodes = (W / dx + 2.0) * (H / dx + 2.0);
+  if (nodes > 2e9) fail(c, "/domain/dx_m", num_str(dx), "a grid of fewer than 2e9 nodes (this is " + num_str(nodes) + ")");
+
+  // materials: unique names, each used by some bed
+  for (size_t i = 0; i < s.materials.size(); ++i) {
+    for (size_t k = 0; k < i; ++k)
+      if (s.materials[k].name == s.materials[i].name)
+        fail(c, idx_path("materials", i, "name"), json(s.materials[i].name),
+             "a name not used by another material (/materials/" + std::to_string(k) + " has it)");
+    bool used = false;
+    for (const auto& b : s.beds) used |= b.material == s.materials[i].name;
+    if (!used)
+      fail(c, idx_path("materials", i, "name"), json(s.materials[i].name),
+           "a material some bed uses (an unused material would still slow the time step)");
+  }
+
+  // beds: inside the domain, at least a cell each way, not overlapping each other
+  for (size_t i = 0; i < s.beds.size(); ++i) {
+    const Bed& b = s.beds[i];
+    if (!(b.max_m.x() > b.min_m.x() && b.max_m.y() > b.min_m.y()))
+      fail(c, idx_path("beds", i, "max_m"), vec_str(b.max_m),
+           "a corner above and right of min_m " + vec_str(b.min_m) + " (the bed is empty)");
+    if ((b.max_m - b.min_m).minCoeff() < dx - tol)
+      fail(c, idx_path("beds", i, "max_m"), vec_str(b.max_m),
+           "a bed at least one cell (dx_m = " + num_str(dx) + ") wide and tall from min_m " + vec_str(b.min_m));
+    if (b.min_m.x() < -tol || b.min_m.y() < -tol)
+      fail(c, idx_path("beds", i, "min_m"), vec_str(b.min_m), "a corner inside the domain [0, " + num_str(W) +
+                                                                  "] x [0, " + num_str(H) + "] m");
+    if (b.max_m.x() > W + tol || b.max_m.y() > H + tol)
+      fail(c, idx_path("beds", i, "max_m"), vec_str(b.max_m), "a corner inside the domain [0, " + num_str(W) +
+                                                                  "] x [0, " + num_str(H) + "] m");
+    for (size_t k = 0; k < i; ++k) {
+      const Bed& o = s.beds[k];
+      const Vec2 lo = b.min_m.cwiseMax(o.min_m), hi = b.max_m.cwiseMin(o.max_m);
+      if (hi.x() - lo.x() > tol && hi.y() - lo.y() > tol)
+        fail(c, idx_path("beds", i), "a bed from " + vec_str(b.min_m) + " to " + vec_str(b.max_m),
+             "beds that do not overlap (it overlaps /beds/" + std::to_string(k) + ")");
+    }
+  }
+
+  // bodies: unique names, resolvable by the grid, inside the domain for the whole run
+  const double t_end = estimate_end_time_s(s);
+  for (size_t i = 0; i < s.bodies.size(); ++i) {
+    const Body& b = s.bodies[i];
+    for (size_t k = 0; k < i; ++k)
+      if (s.bodies[k].name == b.name)
+        fail(c, idx_path("bodies", i, "name"), json(b.name),
+             "a name not used by another body (/bodies/" + std::to_string(k) + " has it)");
+    double feature = kInf;
+    std::string where;
+    smallest_feature(b.shape, idx_path("bodies", i, "shape"), feature, where);
+    if (dx > feature)
+      fail(c, where, "a feature " + num_str(feature) + " m across",
+           "a body at least one cell across (domain.dx_m = " + num_str(dx) + " m); use a smaller dx_m");
+    const auto [lo, hi] = shape_bounds_m(b.shape);
+    if (std::string why = wall_problem(s, b.start_m + lo, b.start_m + hi); !why.empty())
+      fail(c, idx_path("bodies", i, "start_m"), vec_str(b.start_m), "a start that keeps the body inside the domain; " + why);
+    if (motion_max_speed_m_s(b.motion) == 0.0) continue;
+    // sample the run (exact at knots and at the end; position is piecewise quadratic between)
+    std::vector<double> times;
+    for (int k = 1; k <= 256; ++k) times.push_back(t_end * k / 256.0);
+    for (const auto& knot : b.motion.path)
+      if (knot.t_s < t_end) times.push_back(knot.t_s);
+    std::sort(times.begin(), times.end());
+    for (double t : times) {
+      const Vec2 p = b.start_m + motion_displacement_m(b.motion, t);
+      if (std::string why = wall_problem(s, p + lo, p + hi); !why.empty())
+        fail(c, idx_path("bodies", i, "motion"), "a motion reaching " + vec_str(p) + " at t = " + num_str(t) + " s",
+             "a motion that keeps the body inside the domain until the run ends at t = " + num_str(t_end) +
+                 " s; " + why + " (or end the run sooner: solver.end_time_s / end_displacement_m)");
+    }
+  }
+
+  if (s.solver.end_displacement_m > 0.0 && reference_body_index(s) < 0)
+    fail(c, "/solver/end_displacement_m", num_str(s.solver.end_displacement_m), "null: no body moves");
+
+  // averaging window must start before the run ends
+  if (s.outputs.average_from_m >= 0.0) {
+    const int ref = reference_body_index(s);
+    if (ref < 0)
+      fail(c, "/outputs/average_window", "a displacement window", "a time window {\"from_s\", \"to_s\"}: no body moves");
+    const double reach = motion_displacement_m(s.bodies[size_t(ref)].motion, t_end).norm();
+    if (s.outputs.average_from_m >= reach * (1 + 1e-9))
+      fail(c, "/outputs/average_window/from_m", num_str(s.outputs.average_from_m),
+           "a displacement the run reaches (body \"" + s.bodies[size_t(ref)].name + "\" travels " + num_str(reach) + " m)");
+  } else if (s.outputs.average_from_s >= t_end) {
+    fail(c, "/outputs/average_window/from_s", num_str(s.outputs.average_from_s),
+         "a time before the run ends (" + num_str(t_end) + " s)");
+  }
+
+  // cost: `--yes` (allow_large) lets big runs through
+  const double particles = double(estimate_particle_count(s));
+  if (particles > kMaxParticles && !c.options.allow_large)
+    fail(c, "/domain/dx_m", num_str(dx),
+         "at most " + num_str(kMaxParticles) + " particles (estimated " + num_str(particles) +
+             " = bed area / dx^2 * ppc^2); use a larger dx_m, or --yes to accept");
+  const double steps = double(estimate_step_count(s));
+  if (steps > kMaxSteps && !c.options.allow_large)
+    fail(c, "/solver/end_time_s", num_str(s.solver.end_time_s),
+         "at most " + num_str(kMaxSteps) + " steps (estimated " + num_str(steps) + " at dt = " +
+             num_str(estimate_time_step_s(s)) + " s); shorten the run, or --yes to accept");
+}
+
+std::string default_name(const std::string& source) {
+  std::string stem = source;
+  if (auto slash = stem.find_last_of('/'); slash != std::string::npos) stem = stem.substr(slash + 1);
+  if (auto dot = stem.rfind('.'); dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
+  return valid_name(stem) ? stem : "scene";
+}
+
+}  // namespace
+
+Scene parse_scene(const json& j, const std::string& source, const ValidationOptions& options) {
+  const Ctx c{source, options};
+  Obj o(c, j, "", kRootKeys, {}, "a scene: a JSON object");
+  Scene s;
+  const std::string version_rule = "1 (the only schema_version this furrow reads)";
+  const json& version = o.req("schema_version", version_rule);
+  if (!(version.is_number_integer() && version.get<int64_t>() == 1)) fail(c, "/schema_version", version, version_rule);
+  s.schema_version = 1;
+  s.name = name_value(o, "name", default_name(source));
+  if (const json* d = o.opt("description")) s.description = as_string(c, *d, "/description", "a string");
+  s.domain = read_domain(c, o.req("domain", "an object {" + join(kDomainKeys) + "}"));
+  s.solver = read_solver(c, o.req("solver", "an object {" + join(kSolverKeys) + "} with at least end_time_s"));
+
+  const json& mats = array(o, "materials", "material objects", true, 1);
+  for (size_t i = 0; i < mats.size(); ++i) s.materials.push_back(read_material(c, mats[i], idx_path("materials", i)));
+  const json& beds = array(o, "beds", "bed objects", true, 1);
+  for (size_t i = 0; i < beds.size(); ++i) s.beds.push_back(read_bed(c, beds[i], idx_path("beds", i), s));
+  const json& bodies = array(o, "bodies", "body objects", false, 0);
+  for (size_t i = 0; i < bodies.size(); ++i) s.bodies.push_back(read_body(c, bodies[i], idx_path("bodies", i)));
+  s.walls = read_walls(c, o.opt("walls"));
+  s.effects = read_effects(c, o.opt("effects"), s);
+  s.outputs = read_outputs(c, o.opt("outputs"), s);
+  o.finish();
+  check_scene(c, s);
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// output
+
+namespace {
+
+template <class J>
+J vec_json(const Vec2& v) {
+  return J::array({v.x(), v.y()});
+}
+
+template <class J>
+J shape_json(const Shape& s, bool is_part) {
+  J j = J::object();
+  j["type"] = kShapeTypes[size_t(s.kind)];
+  switch (s.kind) {
+    case Shape::Kind::Box: j["size_m"] = vec_json<J>(s.size_m); break;
+    case Shape::Kind::Circle: j["radius_m"] = s.radius_m; break;
+    case Shape::Kind::Polygon:
+      j["vertices_m"] = J::array();
+      for (const auto& v : s.vertices_m) j["vertices_m"].push_back(vec_json<J>(v));
+      break;
+    case Shape::Kind::Union:
+      j["parts"] = J::array();
+      for (const auto& p : s.parts) j["parts"].push_back(shape_json<J>(p, true));
+      break;
+  }
+  if (is_part) j["offset_m"] = vec_json<J>(s.offset_m);
+  return j;
+}
+
+template <class J>
+J wall_json(const Wall& w) {
+  J j = J::object();
+  j["type"] = kWallTypes[size_t(w.kind)];
+  if (w.kind == Wall::Kind::Friction) j["friction"] = w.friction;
+  return j;
+}
+
+template <class J>
+J optional_number(double x) {
+  return x >= 0.0 ? J(x) : J(nullptr);
+}
+
+template <class J>
+J to_json(const Scene& s) {
+  J j = J::object();
+  j["schema_version"] = s.schema_version;
+  j["name"] = s.name;
+  j["description"] = s.description;
+  j["domain"] = {{"width_m", s.domain.width_m}, {"height_m", s.domain.height_m}, {"dx_m", s.domain.dx_m}};
+  J solver = J::object();
+  solver["shape_function"] = kShapeFunctions[size_t(s.solver.shape_function)];
+  solver["particles_per_cell_1d"] = s.solver.particles_per_cell_1d;
+  solver["cfl"] = s.solver.cfl;
+  solver["end_time_s"] = s.solver.end_time_s;
+  solver["end_displacement_m"] = s.solver.end_displacement_m > 0.0 ? J(s.solver.end_displacement_m) : J(nullptr);
+  solver["threads"] = s.solver.threads;
+  solver["max_steps"] = s.solver.max_steps;
+  j["solver"] = solver;
+
+  j["materials"] = J::array();
+  for (const auto& m : s.materials) {
+    J mj = J::object();
+    const bool dpm = m.model == MaterialModel::DPM;
+    mj["name"] = m.name;
+    mj["model"] = kModels[size_t(m.model)];
+    mj["grain_density_kg_m3"] = m.grain_density_kg_m3;
+    mj["phi_c"] = m.phi_c;
+    mj[dpm ? "mu_c" : "mu_s"] = m.mu;
+    if (dpm) {
+      mj["chi"] = m.chi;
+      mj["phi_min"] = m.phi_min;
+    }
+    mj["youngs_modulus_Pa"] = m.youngs_modulus_Pa;
+    mj["poisson_ratio"] = m.poisson_ratio;
+    j["materials"].push_back(mj);
+  }
+  j["beds"] = J::array();
+  for (const auto& b : s.beds) {
+    J bj = J::object();
+    bj["material"] = b.material;
+    bj["min_m"] = vec_json<J>(b.min_m);
+    bj["max_m"] = vec_json<J>(b.max_m);
+    bj["packing_fraction"] = b.packing_fraction;
+    bj["k0"] = b.k0 < 0.0 ? J("jaky") : J(b.k0);
+    j["beds"].push_back(bj);
+  }
+  j["bodies"] = J::array();
+  for (const auto& b : s.bodies) {
+    J bj = J::object();
+    bj["name"] = b.name;
+    bj["shape"] = shape_json<J>(b.shape, false);
+    bj["start_m"] = vec_json<J>(b.start_m);
+    J mj = J::object();
+    mj["type"] = kMotionTypes[size_t(b.motion.kind)];
+    if (b.motion.kind == Motion::Kind::ConstantVelocity) {
+      mj["velocity_m_s"] = vec_json<J>(b.motion.velocity_m_s);
+    } else {
+      mj["knots"] = J::array();
+      for (const auto& k : b.motion.path) {
+        J kj = J::object();
+        kj["t_s"] = k.t_s;
+        kj["velocity_m_s"] = vec_json<J>(k.velocity_m_s);
+        mj["knots"].push_back(kj);
+      }
+    }
+    bj["motion"] = mj;
+    bj["friction"] = b.friction;
+    j["bodies"].push_back(bj);
+  }
+  J walls = J::object();
+  walls["left"] = wall_json<J>(s.walls.left);
+  walls["right"] = wall_json<J>(s.walls.right);
+  walls["bottom"] = wall_json<J>(s.walls.bottom);
+  walls["top"] = wall_json<J>(s.walls.top);
+  j["walls"] = walls;
+  J effects = J::object();
+  effects["gravity"] = s.effects.gravity;
+  effects["gravity_m_s2"] = vec_json<J>(s.effects.gravity_m_s2);
+  effects["dilatancy"] = s.effects.dilatancy;
+  effects["separation"] = s.effects.separation;
+  effects["body_friction"] = s.effects.body_friction;
+  effects["wall_friction"] = s.effects.wall_friction;
+  j["effects"] = effects;
+  J out = J::object();
+  out["frame_interval_s"] = s.outputs.frame_interval_s;
+  out["fields"] = s.outputs.fields;
+  out["movies"] = s.outputs.movies;
+  out["force_interval_s"] = s.outputs.force_interval_s;
+  J window = J::object();
+  if (s.outputs.average_from_m >= 0.0) {
+    window["from_m"] = s.outputs.average_from_m;
+    window["to_m"] = optional_number<J>(s.outputs.average_to_m);
+  } else {
+    window["from_s"] = std::max(0.0, s.outputs.average_from_s);
+    window["to_s"] = optional_number<J>(s.outputs.average_to_s);
+  }
+  out["average_window"] = window;
+  j["outputs"] = out;
+  return j;
+}
+
+}  // namespace
+
+json scene_to_json(const Scene& scene) { return to_json<json>(scene); }
+
+namespace {
+
+using ojson = nlohmann::ordered_json;
+
+bool scalar(const ojson& v) { return !v.is_structured(); }
+bool scalar_array(const ojson& v) {
+  return v.is_array() && std::all_of(v.begin(), v.end(), [](const ojson& x) { return scalar(x); });
+}
+std::string dump_scalar(const ojson& v) { return v.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+// Two-space indented JSON that keeps short things on one line: [x, y] pairs, lists of names,
+// vertex lists, and small objects such as {"type": "slip"}.
+void pretty(const ojson& v, int indent, std::string& out) {
+  const std::string pad(size_t(indent) * 2, ' ');
+  if (scalar(v)) {
+    out += dump_scalar(v);
+  } else if (v.is_array()) {
+    const bool inline_all = scalar_array(v) || std::all_of(v.begin(), v.end(), [](const ojson& x) { return scalar_array(x); });
+    if (v.empty() || inline_all) {
+      out += "[";
+      for (size_t i = 0; i < v.size(); ++i) {
+        if (i) out += ", ";
+        pretty(v[i], 0, out);
+      }
+      out += "]";
+    } else {
+      out += "[\n";
+      for (size_t i = 0; i < v.size(); ++i) {
+        out += pad + "  ";
+        pretty(v[i], indent + 1, out);
+        out += i + 1 < v.size() ? ",\n" : "\n";
+      }
+      out += pad + "]";
+    }
+  } else {
+    if (v.empty()) {
+      out += "{}";
+      return;
+    }
+    bool flat = true;
+    for (const auto& [k, x] : v.items()) flat &= scalar(x) || scalar_array(x);
+    if (flat) {
+      std::string line = "{";
+      bool first = true;
+      for (const auto& [k, x] : v.items()) {
+        line += (first ? "" : ", ") + dump_scalar(ojson(k)) + ": ";
+        pretty(x, 0, line);
+        first = false;
+      }
+      line += "}";
+      if (line.size() <= 72) {
+        out += line;
+        return;
+      }
+    }
+    out += "{\n";
+    size_t i = 0;
+    for (const auto& [k, x] : v.items()) {
+      out += pad + "  " + dump_scalar(ojson(k)) + ": ";
+      pretty(x, indent + 1, out);
+      out += ++i < v.size() ? ",\n" : "\n";
+    }
+    out += pad + "}";
+  }
+}
+
+}  // namespace
+
+std::string format_scene(const Scene& scene) {
+  std::string out;
+  pretty(to_json<ojson>(scene), 0, out);
+  return out + "\n";
+}
+
+// ---------------------------------------------------------------------------------------------
+// text, overrides, files
+
+namespace {
+
+// Tracks where the parser is so that duplicate keys and deep nesting can be reported by path.
+struct ParseTracker {
+  struct Frame {
+    bool is_array = false;
+    long index = -1;
+    std::string key;
+    std::set<std::string> keys;
+  };
+  const Ctx* ctx = nullptr;
+  std::vector<Frame> stack;
+
+  std::string path() const {
+    std::string p;
+    for (size_t i = 0; i + 1 < stack.size(); ++i)
+      p += "/" + (stack[i].is_array ? std::to_string(stack[i].index) : escape_pointer_token(stack[i].key));
+    return p;
+  }
+  void element() {
+    if (!stack.empty() && stack.back().is_array) stack.back().index++;
+  }
+  void push(bool is_array) {
+    element();
+    stack.push_back(Frame{is_array, -1, "", {}});
+    if (stack.size() > size_t(kMaxDepth))
+      fail(*ctx, path(), "nesting " + std::to_string(stack.size()) + " deep", "at most " + std::to_string(kMaxDepth) + " nested levels");
+  }
+  bool operator()(int, json::parse_event_t ev, json& parsed) {
+    switch (ev) {
+      case json::parse_event_t::object_start: push(false); break;
+      case json::parse_event_t::array_start: push(true); break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!stack.empty()) stack.pop_back();
+        break;
+      case json::parse_event_t::key: {
+        Frame& f = stack.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second) {
+          stack.push_back(Frame{});  // so path() includes the key
+          const std::string p = path();
+          stack.pop_back();
+          fail(*ctx, p, short_dump(parsed) + " a second time", "each key once per object");
+        }
+        break;
+      }
+      case json::parse_event_t::value: element(); break;
+    }
+    return true;
+  }
+};
+
+// Turns a nlohmann parse failure into a SceneError with line, column and a snippet.
+[[noreturn]] void syntax_error(const Ctx& c, const std::string& text, size_t byte, const std::string& what) {
+  byte = std::min(byte, text.size());
+  int line = 1, column = 1;
+  for (size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') ++line, column = 1;
+    else ++column;
+  }
+  std::string detail = what;
+  if (auto p = detail.find(": "); p != std::string::npos && detail.find("parse error") != std::string::npos)
+    detail = detail.substr(p + 2);
+  if (auto p = detail.find("] "); detail.rfind("[json.exception", 0) == 0 && p != std::string::npos)
+    detail = detail.substr(p + 2);
+  const size_t from = byte > 24 ? byte - 24 : 0;
+  std::string snippet = text.substr(from, byte - from);
+  for (char& ch : snippet)
+    if (ch == '\n' || ch == '\r' || ch == '\t') ch = ' ';
+  snippet = (byte == text.size() && !text.empty() ? "end of input after " : "") +
+            short_dump(json(snippet));
+  throw SceneError(c.source, "", snippet, "valid JSON (" + detail + ")", "", line, column, byte);
+}
+
+json parse_text(const Ctx& c, const std::string& text) {
+  ParseTracker tracker;
+  tracker.ctx = &c;
+  try {
+    return json::parse(text, std::ref(tracker));
+  } catch (const json::parse_error& e) {
+    syntax_error(c, text, e.byte, e.what());
+  } catch (const json::exception& e) {
+    // number overflow (e.g. 1e999) carries no position: find the literal
+    std::string what = e.what();
+    size_t byte = text.size();
+    if (auto q = what.find('\''); q != std::string::npos) {
+      const std::string lit = what.substr(q + 1, what.rfind('\'') - q - 1);
+      if (auto at = text.find(lit); !lit.empty() && at != std::string::npos) byte = at + lit.size();
+    }
+    syntax_error(c, text, byte, what);
+  }
+}
+
+std::vector<std::string> split_path(const std::string& key_path) {
+  std::vector<std::string> segs;
+  if (!key_path.empty() && key_path[0] == '/') {
+    // JSON pointer
+    std::string cur;
+    for (size_t i = 1; i <= key_path.size(); ++i) {
+      if (i == key_path.size() || key_path[i] == '/') {
+        segs.push_back(cur);
+        cur.clear();
+      } else if (key_path[i] == '~' && i + 1 < key_path.size() && (key_path[i + 1] == '0' || key_path[i + 1] == '1')) {
+        cur += key_path[i + 1] == '0' ? '~' : '/';
+        ++i;
+      } else {
+        cur += key_path[i];
+      }
+    }
+    return segs;
+  }
+  std::string cur;
+  for (char ch : key_path) {
+    if (ch == '.') segs.push_back(cur), cur.clear();
+    else cur += ch;
+  }
+  segs.push_back(cur);
+  return segs;
+}
+
+bool all_digits(const std::string& s) {
+  return !s.empty() && s.size() < 10 && std::all_of(s.begin(), s.end(), [](char ch) { return std::isdigit((unsigned char)ch); });
+}
+
+// Applies one override; returns the JSON pointer it wrote.
+std::string apply_override_at(json& root, const std::string& assignment, const std::string& source) {
+  const Ctx c{source, {}};
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    fail(c, "", json(assignment), "an override key.path=value (e.g. domain.dx_m=0.005)");
+  const std::string key_path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  json value;
+  try {
+    value = json::parse(text);
+  } catch (const json::exception&) {
+    value = text;  // not JSON: a plain string
+  }
+  const std::vector<std::string> segs = split_path(key_path);
+  const std::string note = "in --set " + assignment;
+  json* node = &root;
+  std::string pointer;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    const std::string& seg = segs[i];
+    const bool last = i + 1 == segs.size();
+    if (seg.empty()) throw SceneError(source, pointer, "an empty key", "a key.path like domain.dx_m", note);
+    if (node->is_array()) {
+      size_t idx = node->size() + 1;
+      if (all_digits(seg)) {
+        idx = std::stoul(seg);
+      } else {
+        for (size_t k = 0; k < node->size(); ++k)
+          if ((*node)[k].is_object() && (*node)[k].value("name", json()).is_string() && (*node)[k]["name"] == seg)
+            idx = k;
+      }
+      const bool append = last && idx == node->size();
+      if (idx >= node->size() && !append) {
+        KeyList names;
+        for (const auto& e : *node)
+          if (e.is_object() && e.contains("name") && e["name"].is_string()) names.push_back(e["name"].get<std::string>());
+        std::string expected = node->empty() ? "index 0 (appending to the empty array)"
+                                             : "an index in [0, " + std::to_string(node->size() - 1) + "]" +
+                                                   (last ? " or " + std::to_string(node->size()) + " to append" : "");
+        if (!names.empty()) expected += " or an element name: " + one_of(names) + suggestion(seg, names);
+        throw SceneError(source, pointer + "/" + escape_pointer_token(seg), short_dump(json(seg)), expected, note);
+      }
+      pointer += "/" + std::to_string(idx);
+      if (append) node->push_back(json());
+      node = &(*node)[idx];
+    } else if (node->is_object()) {
+      pointer += "/" + escape_pointer_token(seg);
+      if (!node->contains(seg)) {
+        const std::string parent = pointer.substr(0, pointer.rfind('/'));
+        // keys of any variant are let through: the reader explains e.g. "chi" on an NDPM material
+        const KeyList allowed = schema_keys(root, parent), any_variant = schema_keys(json::object(), parent);
+        if (std::find(allowed.begin(), allowed.end(), seg) == allowed.end() &&
+            std::find(any_variant.begin(), any_variant.end(), seg) == any_variant.end()) {
+          KeyList here = allowed;
+          for (auto it = node->begin(); it != node->end(); ++it)
+            if (std::find(here.begin(), here.end(), it.key()) == here.end()) here.push_back(it.key());
+          throw SceneError(source, pointer, short_dump(json(seg)),
+                           "a key of " + (parent.empty() ? std::string("/") : parent) + suggestion(seg, here) +
+                               (here.empty() ? std::string("") : "; keys here: " + join(here)),
+                           note);
+        }
+        (*node)[seg] = last ? json() : json::object();
+      }
+      node = &(*node)[seg];
+    } else {
+      throw SceneError(source, pointer, short_dump(*node),
+                       "an object or array to hold \"" + seg + "\" (the path goes through a " +
+                           std::string(node->type_name()) + ")",
+                       note);
+    }
+  }
+  *node = value;
+  return pointer;
+}
+
+}  // namespace
+
+void apply_override(json& j, const std::string& assignment, const std::string& source) {
+  apply_override_at(j, assignment, source);
+}
+
+std::vector<std::string> schema_keys(const json& root, const std::string& pointer) {
+  const std::vector<std::string> segs = pointer.empty() ? std::vector<std::string>{} : split_path(pointer);
+  auto node_at = [&](size_t depth) -> const json* {
+    const json* n = &root;
+    for (size_t i = 0; i < depth && n; ++i) {
+      if (n->is_object()) {
+        auto it = n->find(segs[i]);
+        n = it == n->end() ? nullptr : &*it;
+      } else if (n->is_array() && all_digits(segs[i]) && std::stoul(segs[i]) < n->size()) {
+        n = &(*n)[std::stoul(segs[i])];
+      } else {
+        n = nullptr;
+      }
+    }
+    return n;
+  };
+  const size_t n = segs.size();
+  const json* here = node_at(n);
+  auto is = [&](size_t i, const char* s) { return i < n && segs[i] == s; };
+  if (n == 0) return kRootKeys;
+  if (n == 1) {
+    if (is(0, "domain")) return kDomainKeys;
+    if (is(0, "solver")) return kSolverKeys;
+    if (is(0, "walls")) return kWallsKeys;
+    if (is(0, "effects")) return kEffectsKeys;
+    if (is(0, "outputs")) return kOutputsKeys;
+    return {};
+  }
+  if (n == 2) {
+    if (is(0, "materials")) return material_keys(here);
+    if (is(0, "beds")) return kBedKeys;
+    if (is(0, "bodies")) return kBodyKeys;
+    if (is(0, "walls")) return wall_keys(here);
+    if (is(0, "outputs") && is(1, "average_window")) return kWindowKeys;
+    return {};
+  }
+  if (!is(0, "bodies")) return {};
+  if (n == 3 && is(2, "motion")) return motion_keys(here);
+  if (n == 5 && is(2, "motion") && is(3, "knots")) return kKnotKeys;
+  if (is(2, "shape")) {
+    // /bodies/i/shape(/parts/k)*
+    for (size_t i = 3; i < n; i += 2)
+      if (!(is(i, "parts") && i + 1 < n)) return {};
+    return shape_keys(here, n > 3);
+  }
+  return {};
+}
+
+Scene parse_scene_text(const std::string& text, const std::string& source,
+                       const std::vector<std::string>& overrides, const ValidationOptions& options) {
+  const Ctx c{source, options};
+  json j = parse_text(c, text);
+  std::vector<std::pair<std::string, std::string>> written;  // pointer, assignment
+  for (const auto& o : overrides) written.emplace_back(apply_override_at(j, o, source), o);
+  try {
+    return parse_scene(j, source, options);
+  } catch (const SceneError& e) {
+    // name the override responsible for the value at fault (the last one that wrote there)
+    for (auto it = written.rbegin(); it != written.rend(); ++it) {
+      const std::string& p = it->first;
+      const bool inside = e.path == p || (e.path.size() > p.size() && e.path.compare(0, p.size(), p) == 0 &&
+                                          e.path[p.size()] == '/');
+      if (inside) throw SceneError(e.file, e.path, e.value, e.expected, "set by --set " + it->second);
+    }
+    throw;
+  }
+}
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides,
+                 const ValidationOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "", "a file that cannot be opened", "a readable scene file (JSON)");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw SceneError(path, "", "a read error", "a readable scene file (JSON)");
+  return parse_scene_text(ss.str(), path, overrides, options);
+}
+
+}  // namespace furrow
