@@ -1,12 +1,90 @@
-#include "app/commands.hpp"
+// furrow run: scene file -> Scene -> Simulation -> run directory (+ movies rendered from the
+// stored frames).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <iostream>
+
+#include "app/commands.hpp"
+#include "app/progress.hpp"
+#include "app/run_movies.hpp"
+#include "engine/run.hpp"
+#include "engine/scene_io.hpp"
+
+namespace fs = std::filesystem;
+
 namespace furrow::cli {
-static int run_main(const Parsed&) { std::cerr << "furrow run: not implemented yet\n"; return 1; }
-Command command_run() {
-  return {"run", "run a scene: forces.csv, frames, movies under out/", "furrow run SCENE.json [options]", "",
-          {{"--out", true, false, "run directory (default out/<scene name>)", "DIR"},
-           {"--set", true, true, "override a scene value", "key.path=value"},
-           {"--force", false, false, "replace an existing run directory"}},
-          1, 1, run_main};
+
+// Shared by run, sweep and demo: resolves scene, output directory and overrides the same way.
+Scene load_scene_for_cli(const Parsed& p, const std::string& path) {
+  std::vector<std::string> sets = p.all("--set");
+  if (p.has("--threads")) sets.push_back("solver.threads=" + p.get("--threads"));
+  ValidationOptions v;
+  v.allow_large = p.has("--yes");
+  return load_scene(path, sets, v);
 }
+
+static int run_main(const Parsed& p) {
+  Scene scene;
+  try {
+    scene = load_scene_for_cli(p, p.positional[0]);
+  } catch (const SceneError& e) {
+    std::cerr << "furrow run: " << e.what() << "\n";
+    return 1;
+  }
+  RunOptions opt;
+  opt.out_dir = p.get("--out", (fs::path("out") / scene.name).string());
+  opt.force = p.has("--force");
+  opt.write_paraview = !p.has("--no-paraview");
+  if (fs::exists(opt.out_dir) && !opt.force) {
+    std::cerr << "furrow run: " << opt.out_dir
+              << " already exists; pass --out DIR for a new run or --force to replace it\n";
+    return 1;
+  }
+  ProgressPrinter progress(scene.name, p.has("--quiet"));
+  opt.progress = [&](const RunProgress& r) { progress(r); };
+  const RunSummary s = run_scene(scene, opt);
+  progress.finish();
+
+  const auto& j = s.run_json;
+  std::printf("%s: %zu particles, %lld steps, dt %.3g..%.3g s, %.1f s wall, %.2f M particle-steps/s\n",
+              scene.name.c_str(), j["particles"].get<size_t>(), (long long)j["steps"].get<int64_t>(),
+              j["dt_min_s"].get<double>(), j["dt_max_s"].get<double>(), j["wall_seconds"].get<double>(),
+              j["particle_steps_per_second"].get<double>() / 1e6);
+  for (const auto& b : s.bodies)
+    std::printf("  %-12s mean F = (%.4g, %.4g) N/m over the averaging window, peak (%.4g, %.4g) N/m\n",
+                b.name.c_str(), b.mean_N_per_m.x(), b.mean_N_per_m.y(), b.peak_N_per_m.x(), b.peak_N_per_m.y());
+  if (!p.has("--no-movies")) render_run_movies(s.out_dir, scene, p.has("--quiet"));
+  std::printf("outputs in %s\n", s.out_dir.c_str());
+  return 0;
+}
+
+std::vector<OptionSpec> scene_run_options() {
+  return {{"--set", true, true, "override a scene value, e.g. --set domain.dx_m=0.005", "key.path=value"},
+          {"--threads", true, false, "worker threads (default: all cores); same as --set solver.threads=N", "N"},
+          {"--yes", false, false, "accept very large scenes (particle or step estimates over the limits)"},
+          {"--quiet", false, false, "no progress output"}};
+}
+
+Command command_run() {
+  Command c{"run", "run a scene: forces.csv, OpenVDB frames, movies into a run directory",
+            "furrow run SCENE.json [--out DIR] [--set key.path=value ...] [--force]",
+            "Runs the scene and writes DIR (default out/<scene name>):\n"
+            "  scene.json   the scene as run, every default filled in\n"
+            "  forces.csv   t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m (force of the media on each body,\n"
+            "               per metre out of plane; averaged over outputs.force_interval_s)\n"
+            "  frames/      frame_NNNNN.vdb (OpenVDB) and .vti, with frames.pvd for ParaView\n"
+            "  movies/      <field>.mp4 for each field in outputs.movies\n"
+            "  run.json     particles, steps, dt range, wall time, particle-steps/s, peak memory, force summary\n"
+            "The run is built under DIR.partial-PID and renamed into place when complete; an existing DIR\n"
+            "is never overwritten unless --force is given. A scene with errors writes nothing.",
+            {{"--out", true, false, "run directory (default out/<scene name>)", "DIR"},
+             {"--force", false, false, "replace an existing run directory once the new run completes"},
+             {"--no-movies", false, false, "skip rendering movies"},
+             {"--no-paraview", false, false, "skip the ParaView .vti/.pvd files"}},
+            1, 1, run_main};
+  for (auto& o : scene_run_options()) c.options.push_back(o);
+  return c;
+}
+
 }  // namespace furrow::cli

@@ -1,0 +1,52 @@
+// A run: drives a Simulation over a scene and writes its outputs into a run directory
+//   scene.json (as run), forces.csv, frames/frame_NNNNN.vdb (+ .vti and frames.pvd), run.json
+// The directory is built under a temporary name beside the target and renamed into place when the
+// run completes, so a previous run is never overwritten silently and readers never see half a run.
+#pragma once
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/scene.hpp"
+
+namespace furrow {
+
+struct RunProgress {
+  double fraction = 0.0;  // of the end criterion (time or displacement)
+  double time_s = 0.0;
+  int64_t steps = 0;
+  double wall_s = 0.0;
+  double eta_s = 0.0;     // < 0 while unknown
+  size_t particles = 0;
+  double dt_s = 0.0;
+};
+
+struct RunOptions {
+  std::string out_dir;          // final run directory
+  bool force = false;           // replace an existing out_dir (only once the new run completed)
+  bool write_paraview = true;   // .vti per frame + frames.pvd beside the VDB frames
+  double progress_interval_s = 0.5;  // wall seconds between progress callbacks
+  std::function<void(const RunProgress&)> progress;
+};
+
+// Per-body force summary over the scene's averaging window.
+struct BodyForceSummary {
+  std::string name;
+  Vec2 mean_N_per_m{0, 0};   // mean over the window (NaN when the window saw no step)
+  Vec2 peak_N_per_m{0, 0};   // per component, the value of largest magnitude over the run
+  int64_t window_samples = 0;
+};
+
+struct RunSummary {
+  nlohmann::json run_json;  // what run.json holds
+  std::vector<BodyForceSummary> bodies;
+  std::string out_dir;
+};
+
+// Throws std::runtime_error when out_dir exists and !force, or when an output cannot be written.
+RunSummary run_scene(const Scene& scene, const RunOptions& options);
+
+// Peak resident memory of this process (bytes).
+size_t peak_resident_bytes();
+
+}  // namespace furrow
