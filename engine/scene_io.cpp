@@ -60,6 +60,10 @@ std::string short_dump(const json& v) {
 // Shortest text that reads back as the same double ("0", "0.3", "1e-05").
 std::string num_str(double x) {
   char buf[40];
+  if (std::floor(x) == x && std::fabs(x) < 1e7) {
+    std::snprintf(buf, sizeof buf, "%.0f", x);
+    return buf;
+  }
   for (int precision = 1; precision <= 17; ++precision) {
     std::snprintf(buf, sizeof buf, "%.*g", precision, x);
     if (std::strtod(buf, nullptr) == x) break;
@@ -68,6 +72,14 @@ std::string num_str(double x) {
 }
 
 std::string vec_str(const Vec2& v) { return "[" + num_str(v.x()) + ", " + num_str(v.y()) + "]"; }
+
+// Derived quantities (clearances, positions along a path) to four significant digits.
+std::string approx(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.4g", x);
+  return buf;
+}
+std::string approx(const Vec2& v) { return "[" + approx(v.x()) + ", " + approx(v.y()) + "]"; }
 
 std::string escape_pointer_token(const std::string& key) {
   std::string out;
@@ -241,7 +253,7 @@ class Obj {
   Obj(const Ctx& c, const json& j, std::string path, KeyList keys,
       std::map<std::string, std::string> hints = {}, const std::string& what = "an object")
       : c_(c), j_(j), path_(std::move(path)), keys_(std::move(keys)) {
-    if (!j.is_object()) fail(c, display(), j, what + " {" + join(keys_) + "}");
+    if (!j.is_object()) fail(c, path_, j, what + " {" + join(keys_) + "}");
     for (auto it = j.begin(); it != j.end(); ++it) {
       if (std::find(keys_.begin(), keys_.end(), it.key()) != keys_.end()) continue;
       const std::string at = path_ + "/" + escape_pointer_token(it.key());
@@ -756,7 +768,7 @@ std::string wall_problem(const Scene& s, const Vec2& lo, const Vec2& hi) {
     if (side.clearance < -tol) return std::string("it crosses the ") + side.name + " edge of the domain";
   for (const auto& side : sides)
     if (side.wall.kind != Wall::Kind::Open && side.clearance < dx - tol)
-      return std::string("it overlaps the ") + side.name + " wall: clearance " + num_str(side.clearance) +
+      return std::string("it overlaps the ") + side.name + " wall: clearance " + approx(side.clearance) +
              " m is less than one cell (dx_m = " + num_str(dx) + ")";
   return "";
 }
@@ -769,7 +781,7 @@ void check_scene(const Ctx& c, const Scene& s) {
     fail(c, "/domain/dx_m", num_str(dx), "at most a quarter of the domain's smaller side (" +
                                              num_str(0.25 * std::min(W, H)) + " m)");
   const double nodes = (W / dx + 2.0) * (H / dx + 2.0);
-  if (nodes > 2e9) fail(c, "/domain/dx_m", num_str(dx), "a grid of fewer than 2e9 nodes (this is " + num_str(nodes) + ")");
+  if (nodes > 2e9) fail(c, "/domain/dx_m", num_str(dx), "a grid of fewer than 2e9 nodes (this is " + approx(nodes) + ")");
 
   // materials: unique names, each used by some bed
   for (size_t i = 0; i < s.materials.size(); ++i) {
@@ -835,8 +847,8 @@ void check_scene(const Ctx& c, const Scene& s) {
     for (double t : times) {
       const Vec2 p = b.start_m + motion_displacement_m(b.motion, t);
       if (std::string why = wall_problem(s, p + lo, p + hi); !why.empty())
-        fail(c, idx_path("bodies", i, "motion"), "a motion reaching " + vec_str(p) + " at t = " + num_str(t) + " s",
-             "a motion that keeps the body inside the domain until the run ends at t = " + num_str(t_end) +
+        fail(c, idx_path("bodies", i, "motion"), "a motion reaching " + approx(p) + " at t = " + approx(t) + " s",
+             "a motion that keeps the body inside the domain until the run ends at t = " + approx(t_end) +
                  " s; " + why + " (or end the run sooner: solver.end_time_s / end_displacement_m)");
     }
   }
@@ -852,23 +864,23 @@ void check_scene(const Ctx& c, const Scene& s) {
     const double reach = motion_displacement_m(s.bodies[size_t(ref)].motion, t_end).norm();
     if (s.outputs.average_from_m >= reach * (1 + 1e-9))
       fail(c, "/outputs/average_window/from_m", num_str(s.outputs.average_from_m),
-           "a displacement the run reaches (body \"" + s.bodies[size_t(ref)].name + "\" travels " + num_str(reach) + " m)");
+           "a displacement the run reaches (body \"" + s.bodies[size_t(ref)].name + "\" travels " + approx(reach) + " m)");
   } else if (s.outputs.average_from_s >= t_end) {
     fail(c, "/outputs/average_window/from_s", num_str(s.outputs.average_from_s),
-         "a time before the run ends (" + num_str(t_end) + " s)");
+         "a time before the run ends (" + approx(t_end) + " s)");
   }
 
   // cost: `--yes` (allow_large) lets big runs through
   const double particles = double(estimate_particle_count(s));
   if (particles > kMaxParticles && !c.options.allow_large)
     fail(c, "/domain/dx_m", num_str(dx),
-         "at most " + num_str(kMaxParticles) + " particles (estimated " + num_str(particles) +
+         "at most " + num_str(kMaxParticles) + " particles (estimated " + approx(particles) +
              " = bed area / dx^2 * ppc^2); use a larger dx_m, or --yes to accept");
   const double steps = double(estimate_step_count(s));
   if (steps > kMaxSteps && !c.options.allow_large)
     fail(c, "/solver/end_time_s", num_str(s.solver.end_time_s),
-         "at most " + num_str(kMaxSteps) + " steps (estimated " + num_str(steps) + " at dt = " +
-             num_str(estimate_time_step_s(s)) + " s); shorten the run, or --yes to accept");
+         "at most " + num_str(kMaxSteps) + " steps (estimated " + approx(steps) + " at dt = " +
+             approx(estimate_time_step_s(s)) + " s); shorten the run, or --yes to accept");
 }
 
 std::string default_name(const std::string& source) {
@@ -1200,7 +1212,9 @@ struct ParseTracker {
   std::string snippet = text.substr(from, byte - from);
   for (char& ch : snippet)
     if (ch == '\n' || ch == '\r' || ch == '\t') ch = ' ';
-  snippet = (byte == text.size() && !text.empty() ? "end of input after " : "") +
+  const bool at_end = byte >= text.size() && (detail.find("end of input") != std::string::npos ||
+                                               detail.find("missing closing") != std::string::npos);
+  snippet = (at_end ? "end of input after " : "") +
             short_dump(json(snippet));
   throw SceneError(c.source, "", snippet, "valid JSON (" + detail + ")", "", line, column, byte);
 }

@@ -1,6 +1,7 @@
 // Fuzz-style robustness test of the scene reader, built with ASan + UBSan (ctest -L sanitize).
-// Random byte flips, inserts and deletes of every template go through parse_scene_text: each must
-// parse cleanly or throw SceneError; nothing else may escape, crash, or take long.
+// Random byte flips, inserts and deletes of every template, and random edits of their JSON trees
+// (odd values, deleted and added keys), go through parse_scene_text: each must parse cleanly (and
+// round-trip) or throw SceneError; nothing else may escape, crash, or take long.
 // usage: furrow_scene_fuzz SCENE_DIR [ITERATIONS]
 #include <algorithm>
 #include <chrono>
@@ -49,6 +50,50 @@ std::string mutate(std::string s, std::mt19937_64& rng) {
   return s;
 }
 
+using json = nlohmann::json;
+
+// Every node of a document, as pointers into it (for picking one at random).
+void collect(json& j, std::vector<json*>& out) {
+  out.push_back(&j);
+  if (j.is_structured())
+    for (auto& child : j) collect(child, out);
+}
+
+// Values that stress validation: zero, negative, tiny, huge, wrong types, empty containers.
+json odd_value(std::mt19937_64& rng) {
+  static const std::vector<json> values = {
+      0, -1, 1, 2, 0.5, -0.3, 1e-300, 1e300, -1e300, 9, 2.5, 1e-6, 1e6, 4294967297LL, true, false, nullptr,
+      "", "nan", "inf", "jaky", "dpm", "ndpm", "box", "circle", "polygon", "union", "path", "friction",
+      "open", "phi_d", "velocity", json::array(), json::object(), json::array({0, 0}), json::array({1e9, -1e9}),
+      json::array({json::array({0, 0}), json::array({0.01, 0}), json::array({0, 0.01})}),
+      json::parse(R"({"type": "union", "parts": [{"type": "circle", "radius_m": 0.01}]})"),
+      json::parse(R"({"type": "path", "knots": [{"t_s": 0, "velocity_m_s": [0, -0.1]}, {"t_s": 0.5, "velocity_m_s": [0.2, 0]}]})")};
+  return values[std::uniform_int_distribution<size_t>(0, values.size() - 1)(rng)];
+}
+
+// Structure-aware mutation: replace, delete or add one node of the parsed template.
+std::string mutate_tree(const std::string& text, std::mt19937_64& rng) {
+  json j = json::parse(text);
+  const int edits = std::uniform_int_distribution<int>(1, 3)(rng);
+  for (int e = 0; e < edits; ++e) {
+    std::vector<json*> nodes;
+    collect(j, nodes);
+    json* n = nodes[std::uniform_int_distribution<size_t>(0, nodes.size() - 1)(rng)];
+    switch (std::uniform_int_distribution<int>(0, 2)(rng)) {
+      case 0: *n = odd_value(rng); break;
+      case 1:  // delete a member or element
+        if (n->is_object() && !n->empty()) n->erase(n->begin());
+        else if (n->is_array() && !n->empty()) n->erase(n->begin() + long(n->size() - 1));
+        break;
+      case 2:  // add a member or duplicate an element
+        if (n->is_object()) (*n)["extra_key"] = odd_value(rng);
+        else if (n->is_array() && !n->empty()) n->push_back(n->front());
+        break;
+    }
+  }
+  return j.dump(std::uniform_int_distribution<int>(0, 1)(rng) ? 2 : -1);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -77,7 +122,8 @@ int main(int argc, char** argv) {
   const auto t0 = std::chrono::steady_clock::now();
   for (long it = 0; it < iterations; ++it) {
     const auto& [name, text] = seeds[size_t(it) % seeds.size()];
-    const std::string input = mutate(text, rng);
+    // alternate byte-level (syntax) and tree-level (semantic) mutations
+    const std::string input = it % 2 ? mutate(text, rng) : mutate_tree(text, rng);
     const auto start = std::chrono::steady_clock::now();
     try {
       const furrow::Scene s = furrow::parse_scene_text(input, name);
