@@ -17,7 +17,7 @@ using KeyList = std::vector<std::string>;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxDepth = 64;             // JSON nesting
-constexpr size_t kMaxListItems = 10000;  // knots, vertices, bodies...: keeps validation bounded
+constexpr size_t kMaxListItems = 1000;  // knots, vertices, bodies...: keeps validation fast (O(n^2) checks)
 
 // ---- messages ----
 std::string short_dump(const json& v);  // always printable, at most 80 characters

@@ -111,27 +111,33 @@ double time_to_displacement_s(const Motion& motion, double distance_m, double t_
     const double t = v > 0.0 ? distance_m / v : kInf;
     return t <= t_max_s ? t : kInf;
   }
-  // Piecewise-quadratic position: sample each knot interval, then bisect the first crossing.
+  // Piecewise-quadratic position: one sweep over the knot intervals, sampling each and bisecting
+  // the first crossing; the displacement at each interval start is carried along (O(knots)).
   std::vector<double> breaks{0.0};
   for (const auto& k : motion.path)
     if (k.t_s > 0.0 && k.t_s < t_max_s) breaks.push_back(k.t_s);
   breaks.push_back(t_max_s);
-  auto reached = [&](double t) { return motion_displacement_m(motion, t).norm() >= distance_m; };
+  Vec2 d0 = Vec2::Zero();
   constexpr int kSamples = 64;
   for (size_t s = 0; s + 1 < breaks.size(); ++s) {
-    double prev = breaks[s];
+    const double ta = breaks[s], tb = breaks[s + 1];
+    const Vec2 va = motion_velocity_m_s(motion, ta), vb = motion_velocity_m_s(motion, tb);
+    const Vec2 acc = (vb - va) / (tb - ta);  // velocity is linear inside an interval
+    auto disp = [&](double t) { const double u = t - ta; return Vec2(d0 + va * u + 0.5 * acc * u * u); };
+    double prev = ta;
     for (int i = 1; i <= kSamples; ++i) {
-      const double t = breaks[s] + (breaks[s + 1] - breaks[s]) * i / kSamples;
-      if (reached(t)) {
+      const double t = ta + (tb - ta) * i / kSamples;
+      if (disp(t).norm() >= distance_m) {
         double lo = prev, hi = t;
         for (int it = 0; it < 60; ++it) {
           const double mid = 0.5 * (lo + hi);
-          (reached(mid) ? hi : lo) = mid;
+          (disp(mid).norm() >= distance_m ? hi : lo) = mid;
         }
         return hi;
       }
       prev = t;
     }
+    d0 = disp(tb);
   }
   return kInf;
 }

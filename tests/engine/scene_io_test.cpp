@@ -356,7 +356,9 @@ TEST(SceneErrors, MalformedScenesNameThePathAndTheExpectation) {
       EXPECT_EQ(msg.rfind("case.json", 0), 0u) << msg;
       EXPECT_NE(msg.find(", expected "), std::string::npos) << msg;
       EXPECT_NE(msg.find(c.word), std::string::npos) << msg;
-      if (!c.path.empty()) EXPECT_NE(msg.find("case.json: " + c.path + ": got "), std::string::npos) << msg;
+      if (!c.path.empty()) {
+        EXPECT_NE(msg.find("case.json: " + c.path + ": got "), std::string::npos) << msg;
+      }
     } catch (const std::exception& e) {
       ADD_FAILURE() << "not a SceneError: " << e.what();
     }
@@ -425,4 +427,32 @@ TEST(SceneReadme, DocumentsEveryKeyAndItsExampleValidates) {
   const Scene s = furrow::parse_scene_text(readme.substr(start + 8, end - start - 8), "README.md");
   EXPECT_EQ(s.name, "rod_drop");
   EXPECT_EQ(s.bodies[0].motion.path.size(), 2u);
+}
+
+TEST(SceneErrors, LongListsAreAcceptedUpToTheLimit) {
+  // a 1000-knot path (slow start, then steady 0.1 m/s down) and a 1000-vertex plate-like polygon
+  json j = template_json("plate_intrusion");
+  json knots = json::array();
+  for (int k = 0; k < 1000; ++k)
+    knots.push_back({{"t_s", 0.001 * k}, {"velocity_m_s", {0.0, -0.1 * std::min(1.0, k / 100.0)}}});
+  j["bodies"][0]["motion"] = {{"type", "path"}, {"knots", knots}};
+  json ring = json::array();
+  for (int k = 0; k < 1000; ++k) {
+    const double a = 2 * M_PI * k / 1000;
+    ring.push_back({0.05 * std::cos(a), 0.01 * std::sin(a)});
+  }
+  j["bodies"][0]["shape"] = {{"type", "polygon"}, {"vertices_m", ring}};
+  const Scene s = furrow::parse_scene(j, "long.json");
+  // ramp to 0.1 m/s over 0.1 s covers 0.005 m, then 0.135 m more at 0.1 m/s
+  EXPECT_NEAR(furrow::estimate_end_time_s(s), 0.1 + 0.135 / 0.1, 1e-6);
+
+  knots.push_back({{"t_s", 2.0}, {"velocity_m_s", {0.0, 0.0}}});
+  j["bodies"][0]["motion"]["knots"] = knots;
+  try {
+    furrow::parse_scene(j, "long.json");
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.path, "/bodies/0/motion/knots");
+    EXPECT_NE(std::string(e.what()).find("at most 1000"), std::string::npos) << e.what();
+  }
 }
