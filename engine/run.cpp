@@ -212,7 +212,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   auto& j = summary.run_json;
   j["scene"] = scene.name;
   j["particles"] = sim.particles().size();
-  j["grid_nodes"] = sim.grid().mass.size();
+  j["grid_nodes"] = sim.grid().node.size();
   j["steps"] = sim.step_count();
   j["end_time_s"] = sim.time_s();
   j["dt_min_s"] = sim.step_count() ? dt_min : 0.0;

@@ -47,11 +47,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   g_.NX = g_.nx + 1 + 2 * Grid::kPad;
   g_.NY = g_.ny + 1 + 2 * Grid::kPad;
   const size_t nodes = size_t(g_.NX) * g_.NY;
-  g_.mass.assign(nodes, 0.0);
-  g_.vx.assign(nodes, 0.0);
-  g_.vx0.assign(nodes, 0.0);
-  g_.vy0.assign(nodes, 0.0);
-  g_.vy.assign(nodes, 0.0);
+  g_.node.assign(nodes, GridNode{});
 
   bool any_dpm = false;
   for (const auto& m : scene_.materials) {
@@ -179,14 +175,8 @@ double Simulation::lead_body_travel_m() const {
 }
 
 void Simulation::clear_grid() {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.mass.size(), 1 << 14), [&](const auto& r) {
-    std::fill(g_.mass.begin() + r.begin(), g_.mass.begin() + r.end(), 0.0);
-    std::fill(g_.vx.begin() + r.begin(), g_.vx.begin() + r.end(), 0.0);
-    std::fill(g_.vy.begin() + r.begin(), g_.vy.begin() + r.end(), 0.0);
-    if (flip_) {
-      std::fill(g_.vx0.begin() + r.begin(), g_.vx0.begin() + r.end(), 0.0);
-      std::fill(g_.vy0.begin() + r.begin(), g_.vy0.begin() + r.end(), 0.0);
-    }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), 1 << 14), [&](const auto& r) {
+    std::fill(g_.node.begin() + r.begin(), g_.node.begin() + r.end(), GridNode{});
   });
 }
 
@@ -212,12 +202,7 @@ template <class K, bool Flip>
 void Simulation::particles_to_grid() {
   const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
   const double Dinv = K::inv_D(inv_dx);
-  double* gm = g_.mass.data();
-  double* gx = g_.vx.data();
-  double* gy = g_.vy.data();
-  // with FLIP the internal-force impulse is kept apart so the pre-force velocity is known
-  double* ix = Flip ? g_.vx0.data() : g_.vx.data();
-  double* iy = Flip ? g_.vy0.data() : g_.vy.data();
+  GridNode* grid = g_.node.data();
   const auto& P = p_;
   auto scatter_strip = [&](int s) {
     for (uint32_t k = strip_start_[s]; k < strip_start_[s + 1]; ++k) {
@@ -229,30 +214,44 @@ void Simulation::particles_to_grid() {
       const double m = P.mass[p], V = P.volume[p];
       const double sxx = P.sxx[p] - P.pressure[p], syy = P.syy[p] - P.pressure[p], sxy = P.sxy[p];
       const double mvx = m * P.vx[p], mvy = m * P.vy[p];
-      const double c00 = P.c00[p], c01 = P.c01[p], c10 = P.c10[p], c11 = P.c11[p];
+      // momentum affine Q = m C; MLS force affine S = -dt V D^-1 sigma (grad w ~ w D^-1 (x_i - x_p)).
+      // Without FLIP both act on the same momentum and fold into one matrix.
+      const double ks = K::mls ? -dt * V * Dinv : 0.0;
+      const double s00 = ks * sxx, s01 = ks * sxy, s11 = ks * syy;
+      double q00 = m * P.c00[p], q01 = m * P.c01[p], q10 = m * P.c10[p], q11 = m * P.c11[p];
+      if constexpr (K::mls && !Flip) {
+        q00 += s00;
+        q01 += s01;
+        q10 += s01;
+        q11 += s11;
+      }
+      const double dx0 = bx * dx - xp, dy0 = by * dx - yp;
       for (int b = 0; b < K::N; ++b) {
-        const size_t row = g_.index(bx, by + b);
-        const double dyp = (by + b) * dx - yp;
+        GridNode* row = grid + g_.index(bx, by + b);
+        const double dyp = dy0 + b * dx;
         for (int a = 0; a < K::N; ++a) {
-          const size_t node = row + a;
-          const double dxp = (bx + a) * dx - xp;
+          const double dxp = dx0 + a * dx;
           const double w = wx[a] * wy[b];
-          double fx, fy;  // internal-force impulse
-          if constexpr (K::mls) {
-            // MLS: grad w ~ w D^-1 (x_i - x_p)
-            const double k = -dt * V * Dinv * w;
-            fx = k * (sxx * dxp + sxy * dyp);
-            fy = k * (sxy * dxp + syy * dyp);
-          } else {
+          GridNode& n = row[a];
+          n.m += w * m;
+          n.vx += w * (mvx + q00 * dxp + q01 * dyp);
+          n.vy += w * (mvy + q10 * dxp + q11 * dyp);
+          if constexpr (!K::mls) {
+            // true B-spline gradients for the internal force
             const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
-            fx = -dt * V * (sxx * gxw + sxy * gyw);
-            fy = -dt * V * (sxy * gxw + syy * gyw);
+            const double fx = -dt * V * (sxx * gxw + sxy * gyw), fy = -dt * V * (sxy * gxw + syy * gyw);
+            if constexpr (Flip) {
+              n.vx0 += fx;
+              n.vy0 += fy;
+            } else {
+              n.vx += fx;
+              n.vy += fy;
+            }
+          } else if constexpr (Flip) {
+            // FLIP keeps the internal-force impulse apart so the pre-force velocity is known
+            n.vx0 += w * (s00 * dxp + s01 * dyp);
+            n.vy0 += w * (s01 * dxp + s11 * dyp);
           }
-          gm[node] += w * m;
-          gx[node] += w * (mvx + m * (c00 * dxp + c01 * dyp));
-          gy[node] += w * (mvy + m * (c10 * dxp + c11 * dyp));
-          ix[node] += fx;
-          iy[node] += fy;
         }
       }
     }
@@ -265,24 +264,22 @@ void Simulation::particles_to_grid() {
 void Simulation::grid_update() {
   const double dt = dt_s_, gx = gravity_.x() * dt, gy = gravity_.y() * dt;
   const bool flip = flip_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.mass.size(), 1 << 14), [&](const auto& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), 1 << 14), [&](const auto& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) {
-      const double m = g_.mass[k];
-      if (m > 0.0) {
+      GridNode& n = g_.node[k];
+      if (n.m > 0.0) {
+        const double inv_m = 1.0 / n.m;
         if (flip) {
           // vx0 held the force impulse; it becomes the pre-force velocity
-          const double v0x = g_.vx[k] / m, v0y = g_.vy[k] / m;
-          g_.vx[k] = v0x + g_.vx0[k] / m + gx;
-          g_.vy[k] = v0y + g_.vy0[k] / m + gy;
-          g_.vx0[k] = v0x;
-          g_.vy0[k] = v0y;
+          const double v0x = n.vx * inv_m, v0y = n.vy * inv_m;
+          n.vx = v0x + n.vx0 * inv_m + gx;
+          n.vy = v0y + n.vy0 * inv_m + gy;
+          n.vx0 = v0x;
+          n.vy0 = v0y;
         } else {
-          g_.vx[k] = g_.vx[k] / m + gx;
-          g_.vy[k] = g_.vy[k] / m + gy;
+          n.vx = n.vx * inv_m + gx;
+          n.vy = n.vy * inv_m + gy;
         }
-      } else {
-        g_.vx[k] = g_.vy[k] = 0.0;
-        if (flip) g_.vx0[k] = g_.vy0[k] = 0.0;
       }
     }
   });
@@ -318,17 +315,16 @@ void Simulation::bodies_and_walls() {
     Vec2 impulse(0.0, 0.0);
     for (int j = j0; j <= j1; ++j)
       for (int i = i0; i <= i1; ++i) {
-        const size_t k = g_.index(i, j);
-        const double m = g_.mass[k];
-        if (m <= 0.0) continue;
+        GridNode& n = g_.node[g_.index(i, j)];
+        if (n.m <= 0.0) continue;
         const Vec2 q = Vec2(i * dx, j * dx) - s.position_m;
         if (shape_sdf(body.shape, q) >= 0.0) continue;
-        Vec2 v(g_.vx[k], g_.vy[k]);
+        Vec2 v(n.vx, n.vy);
         const Vec2 before = v;
         if (!contact(v, s.velocity_m_s, shape_normal(body.shape, q, 1e-4 * dx), mu)) continue;
-        impulse += m * (v - before);
-        g_.vx[k] = v.x();
-        g_.vy[k] = v.y();
+        impulse += n.m * (v - before);
+        n.vx = v.x();
+        n.vy = v.y();
       }
     s.force_N_per_m = -impulse / dt;
   }
@@ -340,19 +336,18 @@ void Simulation::bodies_and_walls() {
     if (w.kind != Wall::Kind::Open)
       for (int j = j0; j <= j1; ++j)
         for (int i = i0; i <= i1; ++i) {
-          const size_t k = g_.index(i, j);
-          const double m = g_.mass[k];
-          if (m <= 0.0) continue;
-          Vec2 v(g_.vx[k], g_.vy[k]);
+          GridNode& node = g_.node[g_.index(i, j)];
+          if (node.m <= 0.0) continue;
+          Vec2 v(node.vx, node.vy);
           const Vec2 before = v;
           if (w.kind == Wall::Kind::Sticky)
             v.setZero();
           else
             contact(v, Vec2(0.0, 0.0), n,
                     w.kind == Wall::Kind::Friction && wall_friction ? w.friction : 0.0);
-          impulse += m * (v - before);
-          g_.vx[k] = v.x();
-          g_.vy[k] = v.y();
+          impulse += node.m * (v - before);
+          node.vx = v.x();
+          node.vy = v.y();
         }
     wall_forces_[side] = -impulse / dt;
   };
@@ -390,12 +385,13 @@ void Simulation::grid_to_particles() {
         for (int a = 0; a < K::N; ++a) {
           const size_t node = row + a;
           const double w = wx[a] * wy[b];
-          const double gvx = g_.vx[node], gvy = g_.vy[node];
+          const GridNode& n = g_.node[node];
+          const double gvx = n.vx, gvy = n.vy;
           vx += w * gvx;
           vy += w * gvy;
           if constexpr (Flip) {
-            ox += w * g_.vx0[node];
-            oy += w * g_.vy0[node];
+            ox += w * n.vx0;
+            oy += w * n.vy0;
           }
           if constexpr (K::mls) {
             const double dxp = (bx + a) * dx - xp;

@@ -28,14 +28,20 @@ struct Particles {
   size_t size() const { return x.size(); }
 };
 
+// One grid node, interleaved so a particle's 3x3 stencil touches few cache lines.
+struct GridNode {
+  double m;         // mass (kg per metre)
+  double vx, vy;    // momentum during transfer, velocity after grid_update
+  double vx0, vy0;  // FLIP only: force impulse during transfer, pre-force velocity after
+};
+
 // Dense node grid over the domain plus a margin of kPad nodes on every side.
 struct Grid {
   static constexpr int kPad = 3;
   int nx = 0, ny = 0;      // cells over the domain
   int NX = 0, NY = 0;      // nodes including padding
   double dx = 0.0;
-  std::vector<double> mass, vx, vy;  // momentum during transfer, velocity after grid_update
-  std::vector<double> vx0, vy0;      // FLIP only: force impulse in P2G, pre-force velocity after
+  std::vector<GridNode> node;
   size_t index(int i, int j) const { return size_t(j + kPad) * NX + size_t(i + kPad); }
   double node_x(size_t k) const { return (int(k % NX) - kPad) * dx; }
   double node_y(size_t k) const { return (int(k / NX) - kPad) * dx; }
