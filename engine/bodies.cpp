@@ -1,4 +1,5 @@
 #include "engine/bodies.hpp"
+#include "engine/scene_io.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -53,37 +54,6 @@ Vec2 shape_normal(const Shape& s, const Vec2& q, double h) {
   return n > 0.0 ? Vec2(g / n) : Vec2(0.0, 1.0);
 }
 
-void shape_bounds(const Shape& s, Vec2& lo, Vec2& hi) {
-  switch (s.kind) {
-    case Shape::Kind::Circle:
-      lo = s.offset_m - Vec2::Constant(s.radius_m);
-      hi = s.offset_m + Vec2::Constant(s.radius_m);
-      return;
-    case Shape::Kind::Box:
-      lo = s.offset_m - 0.5 * s.size_m;
-      hi = s.offset_m + 0.5 * s.size_m;
-      return;
-    case Shape::Kind::Polygon:
-      lo = hi = s.offset_m + s.vertices_m.front();
-      for (const auto& v : s.vertices_m) {
-        lo = lo.cwiseMin(s.offset_m + v);
-        hi = hi.cwiseMax(s.offset_m + v);
-      }
-      return;
-    case Shape::Kind::Union: {
-      lo = Vec2::Constant(std::numeric_limits<double>::max());
-      hi = -lo;
-      for (const auto& part : s.parts) {
-        Vec2 a, b;
-        shape_bounds(part, a, b);
-        lo = lo.cwiseMin(a + s.offset_m);
-        hi = hi.cwiseMax(b + s.offset_m);
-      }
-      return;
-    }
-  }
-}
-
 std::vector<std::vector<Vec2>> shape_outline(const Shape& s, int circle_segments) {
   std::vector<std::vector<Vec2>> loops;
   switch (s.kind) {
@@ -126,8 +96,7 @@ double shape_min_size(const Shape& s) {
     case Shape::Kind::Box:
       return s.size_m.minCoeff();
     case Shape::Kind::Polygon: {
-      Vec2 lo, hi;
-      shape_bounds(s, lo, hi);
+      const auto [lo, hi] = shape_bounds_m(s);
       return (hi - lo).minCoeff();
     }
     case Shape::Kind::Union: {
@@ -137,32 +106,6 @@ double shape_min_size(const Shape& s) {
     }
   }
   return 0.0;
-}
-
-Vec2 body_velocity(const Motion& m, double t) {
-  if (m.kind == Motion::Kind::ConstantVelocity || m.path.empty()) return m.velocity_m_s;
-  const auto& k = m.path;
-  if (t <= k.front().t_s) return k.front().velocity_m_s;
-  for (size_t i = 1; i < k.size(); ++i)
-    if (t < k[i].t_s) {
-      const double a = (t - k[i - 1].t_s) / (k[i].t_s - k[i - 1].t_s);
-      return (1.0 - a) * k[i - 1].velocity_m_s + a * k[i].velocity_m_s;
-    }
-  return k.back().velocity_m_s;
-}
-
-Vec2 body_displacement(const Motion& m, double t) {
-  if (m.kind == Motion::Kind::ConstantVelocity || m.path.empty()) return m.velocity_m_s * t;
-  // integrate the piecewise-linear velocity exactly (trapezoids), constant outside the knots
-  const auto& k = m.path;
-  Vec2 d = k.front().velocity_m_s * std::min(t, k.front().t_s);
-  for (size_t i = 1; i < k.size() && k[i - 1].t_s < t; ++i) {
-    const double t1 = std::min(t, k[i].t_s);
-    const Vec2 v1 = body_velocity(m, t1);
-    d += 0.5 * (k[i - 1].velocity_m_s + v1) * (t1 - k[i - 1].t_s);
-  }
-  if (t > k.back().t_s) d += k.back().velocity_m_s * (t - k.back().t_s);
-  return d;
 }
 
 }  // namespace furrow

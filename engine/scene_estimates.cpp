@@ -15,7 +15,9 @@ double wave_speed_m_s(const Material& m) {
   const double E = m.youngs_modulus_Pa, nu = m.poisson_ratio;
   const double K = E / (3.0 * (1.0 - 2.0 * nu));
   const double G = E / (2.0 * (1.0 + nu));
-  return std::sqrt((K + 4.0 * G / 3.0) / (m.grain_density_kg_m3 * m.phi_c));
+  // dense DPM material can be as loose as phi_min: lighter, hence faster waves
+  const double phi = m.model == MaterialModel::DPM ? std::min(m.phi_c, m.phi_min) : m.phi_c;
+  return std::sqrt((K + 4.0 * G / 3.0) / (m.grain_density_kg_m3 * phi));
 }
 
 double estimate_time_step_s(const Scene& scene) {

@@ -253,6 +253,7 @@ Solver read_solver(const Ctx& c, const json& j) {
   s.shape_function = ShapeFunction(choice(o, "shape_function", kShapeFunctions, 1));
   s.particles_per_cell_1d = int(integer(o, "particles_per_cell_1d", 1, 8, 2));
   s.cfl = num(o, "cfl", Range{0.0, 1.0, true, false}, "", 0.4);
+  s.flip_blend = num(o, "flip_blend", Range{0.0, 1.0, false, false}, "", 0.99);
   s.end_time_s = num(o, "end_time_s", kPositive, "s");
   if (const json* v = o.opt("end_displacement_m"); v && !v->is_null())
     s.end_displacement_m = as_number(c, *v, o.at("end_displacement_m"), kPositive, "m", ", or null for none");
@@ -316,6 +317,7 @@ Bed read_bed(const Ctx& c, const json& j, const std::string& path, const Scene& 
       b.k0 = as_number(c, *k0, o.at("k0"), Range{0.0, 3.0, true, false}, "", " or \"jaky\"");
     }
   }
+  b.geostatic = boolean(o, "geostatic", true);
   o.finish();
   return b;
 }

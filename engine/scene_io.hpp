@@ -72,7 +72,8 @@ void apply_override(nlohmann::json& j, const std::string& assignment, const std:
 std::vector<std::string> schema_keys(const nlohmann::json& root, const std::string& pointer);
 
 // ---- estimates shared with the solver ----
-// Elastic P-wave speed of a material: sqrt((K + 4G/3) / (rho_g phi_c)).
+// Elastic P-wave speed of a material: sqrt((K + 4G/3) / (rho_g phi)), phi = phi_c (NDPM) or
+// min(phi_c, phi_min) (DPM: dense material may be that loose). The solver's CFL uses it too.
 double wave_speed_m_s(const Material& m);
 // dt = cfl dx / (c + v_body_max), c the fastest material's wave speed.
 double estimate_time_step_s(const Scene& scene);

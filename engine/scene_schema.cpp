@@ -97,13 +97,13 @@ std::string one_of(const KeyList& names) {
 const KeyList kRootKeys = {"schema_version", "name", "description", "domain", "solver", "materials",
                            "beds", "bodies", "walls", "effects", "outputs"};
 const KeyList kDomainKeys = {"width_m", "height_m", "dx_m"};
-const KeyList kSolverKeys = {"shape_function", "particles_per_cell_1d", "cfl", "end_time_s",
+const KeyList kSolverKeys = {"shape_function", "particles_per_cell_1d", "cfl", "flip_blend", "end_time_s",
                              "end_displacement_m", "threads", "max_steps"};
 const KeyList kMaterialNdpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_s",
                                    "youngs_modulus_Pa", "poisson_ratio"};
 const KeyList kMaterialDpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_c", "chi",
                                   "phi_min", "youngs_modulus_Pa", "poisson_ratio"};
-const KeyList kBedKeys = {"material", "min_m", "max_m", "packing_fraction", "k0"};
+const KeyList kBedKeys = {"material", "min_m", "max_m", "packing_fraction", "k0", "geostatic"};
 const KeyList kBodyKeys = {"name", "shape", "start_m", "motion", "friction"};
 const KeyList kBoxKeys = {"type", "size_m"};
 const KeyList kCircleKeys = {"type", "radius_m"};

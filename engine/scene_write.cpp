@@ -58,6 +58,7 @@ J to_json(const Scene& s) {
   solver["shape_function"] = kShapeFunctions[size_t(s.solver.shape_function)];
   solver["particles_per_cell_1d"] = s.solver.particles_per_cell_1d;
   solver["cfl"] = s.solver.cfl;
+  solver["flip_blend"] = s.solver.flip_blend;
   solver["end_time_s"] = s.solver.end_time_s;
   solver["end_displacement_m"] = s.solver.end_displacement_m > 0.0 ? J(s.solver.end_displacement_m) : J(nullptr);
   solver["threads"] = s.solver.threads;
@@ -89,6 +90,7 @@ J to_json(const Scene& s) {
     bj["max_m"] = vec_json<J>(b.max_m);
     bj["packing_fraction"] = b.packing_fraction;
     bj["k0"] = b.k0 < 0.0 ? J("jaky") : J(b.k0);
+    bj["geostatic"] = b.geostatic;
     j["beds"].push_back(bj);
   }
   j["bodies"] = J::array();

@@ -9,27 +9,15 @@
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
+#include <tuple>
 
 #include "engine/bodies.hpp"
+#include "engine/scene_io.hpp"
 #include "engine/shape_functions.hpp"
 
 namespace furrow {
 
-double p_wave_speed_m_s(const Material& m) {
-  const MaterialParams p = MaterialParams::from(m, true);
-  // dense DPM material can be as loose as phi_min: lighter, hence faster waves
-  const double phi = m.model == MaterialModel::DPM ? std::min(m.phi_c, m.phi_min) : m.phi_c;
-  return std::sqrt((p.K + 4.0 / 3.0 * p.G) / (m.grain_density_kg_m3 * phi));
-}
-
 namespace {
-
-bool body_moves(const Body& b) {
-  if (b.motion.kind == Motion::Kind::ConstantVelocity) return b.motion.velocity_m_s.squaredNorm() > 0.0;
-  for (const auto& k : b.motion.path)
-    if (k.velocity_m_s.squaredNorm() > 0.0) return true;
-  return false;
-}
 
 constexpr size_t kGrain = 4096;  // particles per TBB task
 
@@ -52,7 +40,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   bool any_dpm = false;
   for (const auto& m : scene_.materials) {
     materials_.push_back(MaterialParams::from(m, scene_.effects.separation));
-    wave_speed_ = std::max(wave_speed_, p_wave_speed_m_s(m));
+    wave_speed_ = std::max(wave_speed_, furrow::wave_speed_m_s(m));
     any_dpm |= m.model == MaterialModel::DPM;
   }
   dilatancy_ = scene_.effects.dilatancy && any_dpm;
@@ -61,8 +49,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   for (const auto& b : scene_.bodies) {
     BodyState s;
     s.position_m = b.start_m;
-    s.velocity_m_s = body_velocity(b.motion, 0.0);
-    shape_bounds(b.shape, s.lo_m, s.hi_m);
+    s.velocity_m_s = motion_velocity_m_s(b.motion, 0.0);
+    std::tie(s.lo_m, s.hi_m) = shape_bounds_m(b.shape);
     bodies_.push_back(s);
   }
   seed_beds();
@@ -140,7 +128,7 @@ double Simulation::next_dt_s() const {
   double vmax = stats_.max_speed_m_s;
   for (const auto& b : bodies_) vmax = std::max(vmax, b.velocity_m_s.norm());
   for (size_t b = 0; b < bodies_.size(); ++b)
-    vmax = std::max(vmax, body_velocity(scene_.bodies[b].motion, t_s_).norm());
+    vmax = std::max(vmax, motion_velocity_m_s(scene_.bodies[b].motion, t_s_).norm());
   return scene_.solver.cfl * g_.dx / (wave_speed_ + vmax);
 }
 
@@ -169,9 +157,8 @@ bool Simulation::finished() const {
 }
 
 double Simulation::lead_body_travel_m() const {
-  for (size_t b = 0; b < bodies_.size(); ++b)
-    if (body_moves(scene_.bodies[b])) return (bodies_[b].position_m - scene_.bodies[b].start_m).norm();
-  return 0.0;
+  const int b = reference_body_index(scene_);
+  return b < 0 ? 0.0 : (bodies_[size_t(b)].position_m - scene_.bodies[size_t(b)].start_m).norm();
 }
 
 void Simulation::clear_grid() {
@@ -482,8 +469,8 @@ void Simulation::advance_bodies() {
   const double t = t_s_ + dt_s_;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const Body& body = scene_.bodies[b];
-    bodies_[b].position_m = body.start_m + body_displacement(body.motion, t);
-    bodies_[b].velocity_m_s = body_velocity(body.motion, t);
+    bodies_[b].position_m = body.start_m + motion_displacement_m(body.motion, t);
+    bodies_[b].velocity_m_s = motion_velocity_m_s(body.motion, t);
   }
 }
 

@@ -128,7 +128,4 @@ class Simulation {
   std::unique_ptr<tbb::task_arena> arena_;
 };
 
-// P-wave speed of a material's elastic part at its dense packing (m/s); sets the CFL time step.
-double p_wave_speed_m_s(const Material& m);
-
 }  // namespace furrow
