@@ -66,7 +66,16 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     case ShapeFunction::Quadratic: pick(QuadraticKernel{}); break;
     case ShapeFunction::Cubic: pick(CubicKernel{}); break;
   }
-  constitutive_ = dilatancy_ ? &Simulation::constitutive_update<true> : &Simulation::constitutive_update<false>;
+  // plastic strain and its rate are kept only when a stored field needs them
+  for (const auto& f : scene_.outputs.fields) track_plastic_ |= f == "strain_rate" || f == "plastic_strain";
+  if (dilatancy_)
+    constitutive_ = track_plastic_ ? &Simulation::constitutive_update<true, true> : &Simulation::constitutive_update<true, false>;
+  else
+    constitutive_ = track_plastic_ ? &Simulation::constitutive_update<false, true> : &Simulation::constitutive_update<false, false>;
+  if (!track_plastic_) {
+    p_.plastic_strain = {};
+    p_.strain_rate = {};
+  }
   const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
   arena_ = std::make_unique<tbb::task_arena>(threads);
   reorder_particles();
@@ -441,7 +450,7 @@ void Simulation::grid_to_particles() {
   stats_.max_speed_m_s = std::sqrt(vmax2);
 }
 
-template <bool Dilatancy>
+template <bool Dilatancy, bool Track>
 void Simulation::constitutive_update() {
   const double dt = dt_s_;
   std::vector<PlasticityModel<Dilatancy>> models;
@@ -450,7 +459,7 @@ void Simulation::constitutive_update() {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, P.size(), kGrain), [&](const auto& r) {
     for (size_t p = r.begin(); p < r.end(); ++p) {
       PointState s{P.volume[p], P.sxx[p], P.syy[p], P.sxy[p], P.szz[p], P.pressure[p],
-                   Dilatancy ? P.phi_d[p] : 0.0, P.plastic_strain[p], 0.0};
+                   Dilatancy ? P.phi_d[p] : 0.0, Track ? P.plastic_strain[p] : 0.0, 0.0};
       models[P.material[p]].update(dt, P.c00[p], P.c01[p], P.c10[p], P.c11[p], P.mass[p], s);
       P.volume[p] = s.volume_m2;
       P.sxx[p] = s.sxx;
@@ -459,8 +468,10 @@ void Simulation::constitutive_update() {
       P.szz[p] = s.szz;
       P.pressure[p] = s.pressure_Pa;
       if constexpr (Dilatancy) P.phi_d[p] = s.phi_d;
-      P.plastic_strain[p] = s.plastic_strain;
-      P.strain_rate[p] = s.strain_rate_1_s;
+      if constexpr (Track) {
+        P.plastic_strain[p] = s.plastic_strain;
+        P.strain_rate[p] = s.strain_rate_1_s;
+      }
     }
   });
 }
@@ -535,8 +546,8 @@ ParticleView Simulation::particle_view() const {
   v.vx_m_s = p_.vx.data();
   v.vy_m_s = p_.vy.data();
   v.pressure_Pa = p_.pressure.data();
-  v.strain_rate_1_s = p_.strain_rate.data();
-  v.plastic_strain = p_.plastic_strain.data();
+  v.strain_rate_1_s = track_plastic_ ? p_.strain_rate.data() : nullptr;
+  v.plastic_strain = track_plastic_ ? p_.plastic_strain.data() : nullptr;
   v.phi_d = dilatancy_ ? p_.phi_d.data() : nullptr;
   v.grain_density_kg_m3 = rho_g_cache_.data();
   return v;

@@ -23,7 +23,7 @@ struct Particles {
   std::vector<double> sxx, syy, sxy, szz;      // deviatoric stress (Pa)
   std::vector<double> pressure;                // Pa
   std::vector<double> phi_d;                   // DPM dense-state packing; empty without dilatancy
-  std::vector<double> plastic_strain, strain_rate;
+  std::vector<double> plastic_strain, strain_rate;  // only when an output field needs them
   std::vector<uint8_t> material;               // index into Scene::materials
   size_t size() const { return x.size(); }
 };
@@ -101,7 +101,7 @@ class Simulation {
   void grid_update();
   void bodies_and_walls();
   template <class Kernel, bool Flip> void grid_to_particles();
-  template <bool Dilatancy> void constitutive_update();
+  template <bool Dilatancy, bool Track> void constitutive_update();
   void advance_bodies();
   void reorder_particles();
 
@@ -117,6 +117,7 @@ class Simulation {
   Vec2 gravity_{0, 0};
   bool dilatancy_ = false;
   bool flip_ = false;
+  bool track_plastic_ = false;
   // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
   static constexpr int kStripCells = 4;
   std::vector<uint32_t> order_, strip_start_;
