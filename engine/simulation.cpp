@@ -520,6 +520,17 @@ void Simulation::reorder_particles() {
   });
 }
 
+size_t Simulation::state_bytes() const {
+  size_t b = 0;
+  for (const auto* a : {&p_.x, &p_.y, &p_.vx, &p_.vy, &p_.c00, &p_.c01, &p_.c10, &p_.c11, &p_.mass, &p_.volume,
+                        &p_.sxx, &p_.syy, &p_.sxy, &p_.szz, &p_.pressure, &p_.phi_d, &p_.plastic_strain,
+                        &p_.strain_rate})
+    b += a->capacity() * sizeof(double);
+  b += p_.material.capacity() + g_.node.capacity() * sizeof(GridNode);
+  b += (order_.capacity() + strip_start_.capacity() + scratch_u32_.capacity()) * sizeof(uint32_t);
+  return b;
+}
+
 double Simulation::total_mass() const { return std::accumulate(p_.mass.begin(), p_.mass.end(), 0.0); }
 
 Vec2 Simulation::total_momentum() const {

@@ -86,6 +86,7 @@ class Simulation {
   double lead_body_travel_m() const;
 
   // diagnostics
+  size_t state_bytes() const;  // particle, grid and sorting arrays actually allocated
   double total_mass() const;
   Vec2 total_momentum() const;
   double kinetic_energy() const;
