@@ -12,6 +12,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "engine/analysis.hpp"
 #include "engine/field_store.hpp"
 #include "engine/scene_io.hpp"
 #include "engine/simulation.hpp"
@@ -135,6 +136,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   Simulation sim(scene);
   ForceLog forces((tmp_dir / "forces.csv").string(), scene);
   ForceStats stats(scene);
+  RunAnalysis analysis(scene);  // run.json "analysis": drag statistics, wedge per frame
 
   const auto& out = scene.outputs;
   std::vector<std::string> fields;
@@ -154,6 +156,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     f.time_s = sim.time_s();
     f.dt_s = sim.last_dt_s();
     f.bodies = sim.body_outlines();
+    if (analysis.wants_frames())
+      analysis.add_frame(f, sim.lead_body_travel_m(), sim.bodies()[size_t(analysis.lead_index())].velocity_m_s);
     write_frame_vdb(frame_path(tmp_dir.string(), frame_index), f);
     if (opt.write_paraview) {
       write_vti(frame_path(tmp_dir.string(), frame_index, "vti"), f);
@@ -196,6 +200,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     dt_max = std::max(dt_max, sim.last_dt_s());
     forces.add(sim);
     stats.add(sim);
+    if (analysis.active()) {
+      const BodyState& lead = sim.bodies()[size_t(analysis.lead_index())];
+      analysis.add_step(sim.time_s(), sim.lead_body_travel_m(), lead.force_N_per_m, lead.velocity_m_s);
+    }
     if (frames_on && sim.time_s() >= next_frame_s - 1e-12) write_frame();
     report(false);
   }
@@ -232,6 +240,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
                            {"mean_force_N_per_m", vec_json(b.mean_N_per_m)},
                            {"peak_force_N_per_m", vec_json(b.peak_N_per_m)},
                            {"window_steps", b.window_samples}});
+  if (analysis.active()) j["analysis"] = analysis.to_json();
   write_file_atomic((tmp_dir / "run.json").string(), j.dump(2) + "\n");
 
   // move into place; an existing run (only with --force) is replaced after the new one is whole

@@ -1,0 +1,153 @@
+// Post-processing of a run's physics (paper cases 3 and 4), used by run_scene for run.json and by
+// the tests:
+//   - drag-signal statistics over a window of body travel (mean, fluctuation amplitude, period);
+//   - the rigid wedge ("no-shear zone") under a vertically intruding plate, from a velocity frame.
+//
+// Drag statistics, precisely (drag_statistics):
+//   1. samples (travel s_k, drag F_k) with s_k inside [from_m, to_m] are box-averaged into bins of
+//      `bin_m` travel (default: one grid cell). The plate's cell-crossing noise has period dx in
+//      travel, so a box of one cell removes it; the box also anti-aliases the even resampling.
+//      Empty bins are filled by linear interpolation between their neighbours.
+//   2. mean drag = mean of the bins (a travel average).
+//   3. the bins are detrended by a least-squares line in travel (the drag of a plow grows as the
+//      spoil ahead of it accumulates; that growth is not a fluctuation).
+//   4. fluctuation amplitude = RMS of the detrended bins; relative amplitude = RMS / |mean|.
+//      (For F = F0 + a s + A sin(2 pi s / p): RMS = A / sqrt 2.)
+//   5. dominant period = travel per cycle of the largest peak of the periodogram of the detrended
+//      bins, if that peak passes Fisher's g-test for a periodic component in white noise at
+//      significance `alpha`, and the window holds at least `min_cycles` periods; NaN otherwise.
+//      The peak frequency is refined by Gaussian (log-parabolic) interpolation of the
+//      Hann-windowed spectrum around the peak bin.
+//
+// Wedge, precisely (measure_wedge):
+//   region = active cells strictly below the plate's bottom face whose velocity v satisfies
+//            |v - v_plate| < tolerance |v_plate|, 4-connected to such cells in the first
+//            `seed_rows` rows under the face, and within one cell of the face's x-range;
+//   per row of the region, its left and right edges x_L(z), x_R(z) at depth z below the face,
+//            placed where the mismatch crosses the tolerance (linear between the last cell in and
+//            the first cell out; the cell edge at a free surface);
+//   flanks = least-squares lines x_L = a_L + tan(alpha_L) z and x_R = a_R - tan(alpha_R) z over
+//            the rows at least 3 cells wide (the 1-2 cell apex rows are quantisation), starting at
+//            the widest of the first `seed_rows` rows (a layer sliding along the face is not the
+//            zone's outline);
+//   apex angle = alpha_L + alpha_R: the full angle between the flanks (degrees), whether they meet
+//            inside the region (a wedge) or not (a trapezoid, the early stage);
+//   height = depth of the deepest region row's lower edge below the face.
+// The tolerance 0.1 sits between the noise of the rigid core (a few % of the plate speed in a
+// rasterized frame) and the material compacting below the wedge (20-35% slower than the plate in
+// the loose bed of case 4); the angle falls as the tolerance grows (that slower material joins
+// the region), so compare runs at one tolerance. Per-frame scatter is several degrees at 15-20
+// cells across the plate: compare medians over frames. Frames taken while the face is within a
+// few tenths of a cell above a grid node line show the grid contact lagging (the layer under the
+// face moves up to 80% slower for a few steps), so the per-frame entries carry the face's offset.
+//
+// The quantity compared with the paper's pi/2 - atan(mu) is the FULL apex angle. Slip-line
+// theory for a plate pressed into a frictional half-space (Prandtl's mechanism) bounds the rigid
+// zone by slip lines at pi/4 + phi/2 from the horizontal, so the angle between them is
+// pi - 2 (pi/4 + phi/2) = pi/2 - phi, with tan(phi) = mu; the paper's section 3.2 calls
+// pi/2 - atan(mu) the wedge's "acute angle" and section 3.4 its "apex angle". Its last sentence
+// says "half-angle"; taken literally that is Terzaghi's rough-footing wedge (sides at phi to the
+// horizontal), a wedge (L/2) tan(phi) deep: 11 mm for the 40 mm plate, against the 30-35 mm deep
+// zones the simulations show. (With Drucker-Prager in plane strain, mu = sin(phi) strictly,
+// which would put the apex at 90 - asin(0.53) = 58 deg instead of 62 for mu_c = 0.53.)
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/fields.hpp"
+#include "engine/scene.hpp"
+
+namespace furrow {
+
+// ---------------------------------------------------------------- drag signal statistics
+struct DragStatsOptions {
+  double from_m = 0.0;       // window of travel
+  double to_m = -1.0;        // < 0: to the last sample
+  double bin_m = 0.0;        // resampling box; <= 0: (window length) / 1024
+  double alpha = 1e-3;       // significance of the periodicity test
+  double min_cycles = 2.0;   // a period must fit this many times in the window
+};
+
+struct DragStats {
+  int64_t samples = 0;          // raw samples inside the window
+  int bins = 0;                 // evenly spaced resampled values
+  double from_m = 0.0, to_m = 0.0, bin_m = 0.0;
+  double mean_N_per_m = 0.0;    // NaN when no sample falls in the window
+  // NaN (like the period) when the window holds fewer than 3 bins
+  double trend_N_per_m2 = 0.0;  // slope of the removed linear trend (per metre of travel)
+  double rms_N_per_m = 0.0;     // RMS of the detrended signal
+  double relative_fluctuation = 0.0;  // rms / |mean|
+  double period_m = 0.0;        // dominant period in travel; NaN when there is no clear peak
+  double period_p_value = 1.0;  // Fisher g-test p-value of the largest periodogram peak
+};
+
+// travel_m and drag_N_per_m: one sample each (e.g. one per step), travel non-decreasing.
+DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector<double>& drag_N_per_m,
+                          const DragStatsOptions& options);
+
+// Whether a step at time t_s with lead-body travel travel_m lies in the scene's averaging window
+// (outputs.average_window: by displacement when from_m >= 0, else by time; a negative "to" means
+// the end of the run).
+bool in_average_window(const Outputs& out, double t_s, double travel_m);
+
+// ---------------------------------------------------------------- rigid wedge under a plate
+struct WedgeOptions {
+  double tolerance = 0.1;   // |v - v_plate| < tolerance |v_plate| counts as moving with the plate
+  int seed_rows = 3;        // the region grows from cells in this many rows under the face
+  int min_fit_rows = 3;     // fewer flank rows than this: no angle (NaN)
+};
+
+struct WedgeMeasure {
+  bool found = false;        // a region under the plate exists
+  int cells = 0;             // cells in the region
+  int rows = 0;              // rows spanned
+  int fit_rows = 0;          // rows used by the flank fits
+  double apex_angle_deg = 0.0;   // alpha_L + alpha_R; NaN when not measurable
+  double left_flank_deg = 0.0;   // alpha_L, from the vertical, positive when converging
+  double right_flank_deg = 0.0;  // alpha_R
+  double height_m = 0.0;         // deepest region row's lower edge below the plate face
+  double apex_depth_m = 0.0;     // where the fitted flanks meet (NaN if parallel/diverging)
+  double face_y_m = 0.0, face_x0_m = 0.0, face_x1_m = 0.0;  // the plate's bottom face
+  std::vector<uint8_t> mask;     // nx*ny, 1 in the region (for plots and tests)
+};
+
+// frame: a FieldFrame with velocity; plate: the intruder's outline in world coordinates.
+// Throws std::invalid_argument when the frame has no velocity or the plate velocity is zero.
+WedgeMeasure measure_wedge(const FieldFrame& frame, const BodyOutline& plate, const Vec2& plate_velocity_m_s,
+                           const WedgeOptions& options = {});
+
+// The slip-line wedge apex angle pi/2 - atan(mu) in degrees (see the header comment).
+double slip_line_apex_angle_deg(double mu);
+
+// ---------------------------------------------------------------- run.json hook
+// Collects what the "analysis" section of run.json needs while a run goes, at no cost when the
+// scene has no moving body. Drag of the lead body = -(force . unit velocity), the media's
+// resistance to its motion (N/m).
+class RunAnalysis {
+ public:
+  explicit RunAnalysis(const Scene& scene);
+  bool active() const { return lead_ >= 0; }
+  int lead_index() const { return lead_; }  // index in Scene::bodies; -1 when none moves
+  // after each step: the lead body's force and velocity, time and travel
+  void add_step(double t_s, double travel_m, const Vec2& force_N_per_m, const Vec2& velocity_m_s);
+  // whether frames should be handed to add_frame (velocity stored and the lead body moves
+  // vertically)
+  bool wants_frames() const { return wedge_; }
+  // a frame just rasterized; bodies as in frame.bodies, lead body's velocity
+  void add_frame(const FieldFrame& frame, double travel_m, const Vec2& velocity_m_s);
+  nlohmann::json to_json() const;
+
+ private:
+  int lead_ = -1;
+  std::string lead_name_;
+  const Outputs* out_ = nullptr;
+  double dx_m_ = 0.0;
+  bool wedge_ = false;
+  std::vector<double> travel_m_, drag_N_per_m_;
+  nlohmann::json frames_ = nlohmann::json::array();
+};
+
+}  // namespace furrow
