@@ -151,6 +151,14 @@ bool in_average_window(const Outputs& out, double t_s, double travel_m) {
   return t_s >= out.average_from_s && (out.average_to_s < 0.0 || t_s <= out.average_to_s);
 }
 
+double median_finite(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 double slip_line_apex_angle_deg(double mu) { return 90.0 - std::atan(mu) * 180.0 / kPi; }
 
 WedgeMeasure measure_wedge(const FieldFrame& f, const BodyOutline& plate, const Vec2& v_plate,
@@ -374,15 +382,32 @@ nlohmann::json RunAnalysis::to_json() const {
                {"relative_fluctuation", num(d.relative_fluctuation)},
                {"period_m", num(d.period_m)},
                {"period_p_value", num(d.period_p_value)}};
+  if (wedge_) {
+    // medians over the first quarter and the second half of the travel the frames cover
+    double last = 0.0;
+    for (const auto& e : frames_) last = std::max(last, e.at("travel_m").get<double>());
+    std::vector<double> early, late;
+    for (const auto& e : frames_) {
+      if (e.at("apex_angle_deg").is_null()) continue;
+      const double s = e.at("travel_m").get<double>(), a = e.at("apex_angle_deg").get<double>();
+      if (s <= 0.25 * last) early.push_back(a);
+      if (s >= 0.5 * last) late.push_back(a);
+    }
+    j["wedge"] = {{"early_median_apex_angle_deg", num(median_finite(early))},
+                  {"late_median_apex_angle_deg", num(median_finite(late))},
+                  {"early_frames", early.size()},
+                  {"late_frames", late.size()}};
+  }
   if (wedge_)
-    j["wedge"] = {{"definition",
+    j["wedge"].update({{"definition",
                    "cells below the plate face moving with it (|v - v_plate| < 0.1 |v_plate|), connected "
                    "to the face; apex_angle_deg = full angle between least-squares flank lines (compare "
                    "with 90 - atan(mu) deg; frames scatter by several degrees, compare medians); "
                    "height_m = depth of the region below the face; face_offset_cells = height of the "
                    "face above the grid node line below it, in cells (near 0 the grid contact lags and "
-                   "the zone may be lost); see engine/analysis.hpp"},
-                  {"frames", frames_}};
+                   "the zone may be lost); early/late medians over the frames with an angle in the first "
+                   "quarter / second half of the travel; see engine/analysis.hpp"},
+                  {"frames", frames_}});
   return j;
 }
 

@@ -119,6 +119,9 @@ struct WedgeMeasure {
 WedgeMeasure measure_wedge(const FieldFrame& frame, const BodyOutline& plate, const Vec2& plate_velocity_m_s,
                            const WedgeOptions& options = {});
 
+// Median of the finite values (NaN when there are none): per-frame angles scatter.
+double median_finite(std::vector<double> values);
+
 // The slip-line wedge apex angle pi/2 - atan(mu) in degrees (see the header comment).
 double slip_line_apex_angle_deg(double mu);
 

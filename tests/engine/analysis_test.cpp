@@ -278,6 +278,12 @@ TEST(Wedge, NoRegionWhenNothingMovesWithThePlateAndErrorsOnBadInput) {
   EXPECT_THROW(measure_wedge(f, plate_outline(0.15), kVPlate), std::invalid_argument);
 }
 
+TEST(Wedge, MedianSkipsMissingAngles) {
+  EXPECT_DOUBLE_EQ(median_finite({3.0, NAN, 1.0, 2.0}), 2.0);
+  EXPECT_DOUBLE_EQ(median_finite({4.0, 1.0, NAN, 2.0, 3.0, INFINITY}), 2.5);
+  EXPECT_TRUE(std::isnan(median_finite({NAN})));
+}
+
 TEST(Wedge, SlipLineAngle) {
   EXPECT_NEAR(slip_line_apex_angle_deg(0.0), 90.0, 1e-12);  // Prandtl's frictionless wedge
   EXPECT_NEAR(slip_line_apex_angle_deg(0.53), 62.08, 0.01);
@@ -317,7 +323,10 @@ TEST(RunAnalysis, RunJsonHasDragStatisticsAndWedgePerFrame) {
   EXPECT_NEAR(d.at("to_m").get<double>(), 0.011, 1e-4);
   // the plate pushes down: drag is the upward reaction, positive
   EXPECT_GT(d.at("mean_N_per_m").get<double>(), 0.0);
-  EXPECT_EQ(a.at("wedge").at("frames").size(), size_t(r.run_json.at("frames").get<int64_t>()));
+  const auto& w = a.at("wedge");
+  EXPECT_EQ(w.at("frames").size(), size_t(r.run_json.at("frames").get<int64_t>()));
+  for (const auto& e : w.at("frames")) EXPECT_TRUE(e.contains("apex_angle_deg") && e.contains("height_m"));
+  EXPECT_TRUE(w.contains("early_median_apex_angle_deg") && w.contains("late_median_apex_angle_deg"));
   std::ifstream in(dir + "/run.json");
   EXPECT_EQ(nlohmann::json::parse(in).at("analysis"), a);
   std::filesystem::remove_all(dir);
