@@ -37,9 +37,11 @@
 // rasterized frame) and the material compacting below the wedge (20-35% slower than the plate in
 // the loose bed of case 4); the angle falls as the tolerance grows (that slower material joins
 // the region), so compare runs at one tolerance. Per-frame scatter is several degrees at 15-20
-// cells across the plate: compare medians over frames. Frames taken while the face is within a
-// few tenths of a cell above a grid node line show the grid contact lagging (the layer under the
-// face moves up to 80% slower for a few steps), so the per-frame entries carry the face's offset.
+// cells across the plate: compare medians over frames. The solver's body constrains only grid
+// nodes inside it, so as the face descends through a cell the layer under it slows (half the
+// plate's speed 0.1 cell above the next node line, nearly at rest just before it) and catches up
+// once the face passes the node line; frames taken then may lose the zone, so the per-frame
+// entries carry the face's offset above the node line below it.
 //
 // The quantity compared with the paper's pi/2 - atan(mu) is the FULL apex angle. Slip-line
 // theory for a plate pressed into a frictional half-space (Prandtl's mechanism) bounds the rigid

@@ -252,9 +252,9 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 //
 // Frames: one per third of a cell of travel, taken when the face is 0.45, 0.65 and 0.85 cell
 // above the grid node line below it. The body constrains only grid nodes inside it, so as the
-// face descends through a cell the layer under it is pushed less and less and, within ~0.2 cell
-// of the next node line, lags the plate by up to 80%: the zone can vanish from such a frame.
-// Away from it the rigid core moves with the plate to within a few %. Single frames scatter by ~8 deg (particle noise on 16 cells), so the claim
+// face descends through a cell the layer under it is pushed less and less (half the plate's
+// speed 0.1 cell above the next node line): the zone can vanish from such a frame. At these
+// offsets the rigid core moves with the plate to within a few %. Single frames scatter by ~8 deg (particle noise on 16 cells), so the claim
 // is tested on medians: early = the first 12.5 mm of intrusion (0.3 L), late = 30-50 mm.
 TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
   const double dx = 0.0025, bed_w = 0.25, bed_h = 0.16, gap = 0.002, v = 0.15, travel = 0.05;
