@@ -1,0 +1,502 @@
+#include "render/frame_renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include <vtkActor.h>
+#include <vtkAxis.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkChartLegend.h>
+#include <vtkChartXY.h>
+#include <vtkContextActor.h>
+#include <vtkContextScene.h>
+#include <vtkFloatArray.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkImageActor.h>
+#include <vtkImageData.h>
+#include <vtkImageMapToColors.h>
+#include <vtkImageMapper3D.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
+#include <vtkPlotPoints.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTable.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+
+#include "render/colormap.hpp"
+#include "render/gl_context.hpp"
+
+namespace furrow::render {
+
+// ---- field values and ranges --------------------------------------------------------------------
+namespace {
+std::string valid_field_list() {
+  std::string s;
+  for (const auto& f : field_registry()) s += (s.empty() ? "" : ", ") + f.name;
+  return s;
+}
+
+const FieldInfo& require_field(const std::string& field) {
+  const FieldInfo* info = find_field(field);
+  if (!info) throw std::invalid_argument("unknown field '" + field + "' (valid fields: " + valid_field_list() + ")");
+  return *info;
+}
+
+std::string frame_fields(const FieldFrame& f) {
+  std::string s;
+  for (const auto& [name, v] : f.scalars) s += (s.empty() ? "" : ", ") + name;
+  if (!f.velocity_x.empty()) s += std::string(s.empty() ? "" : ", ") + "velocity";
+  return s.empty() ? "none" : s;
+}
+}  // namespace
+
+std::vector<float> field_values(const FieldFrame& frame, const std::string& field) {
+  const FieldInfo& info = require_field(field);
+  const size_t n = size_t(frame.nx) * size_t(frame.ny);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> out(n, nan);
+  const bool has_mask = frame.active.size() == n;
+  if (info.vector) {
+    if (frame.velocity_x.size() != n || frame.velocity_y.size() != n)
+      throw std::runtime_error("frame at step " + std::to_string(frame.step) + " has no field 'velocity' (it has: " +
+                               frame_fields(frame) + ")");
+    for (size_t k = 0; k < n; ++k)
+      if (!has_mask || frame.active[k]) out[k] = std::hypot(frame.velocity_x[k], frame.velocity_y[k]);
+    return out;
+  }
+  auto it = frame.scalars.find(field);
+  if (it == frame.scalars.end() || it->second.size() != n)
+    throw std::runtime_error("frame at step " + std::to_string(frame.step) + " has no field '" + field +
+                             "' (it has: " + frame_fields(frame) + ")");
+  for (size_t k = 0; k < n; ++k)
+    if (!has_mask || frame.active[k]) out[k] = it->second[k];
+  return out;
+}
+
+RangeAccumulator::RangeAccumulator(const std::string& field) : field_(field), log_(require_field(field).log_scale) {}
+
+void RangeAccumulator::add(const FieldFrame& frame) {
+  for (float v : field_values(frame, field_)) {
+    if (!std::isfinite(v)) continue;
+    if (!any_) min_ = max_ = v, any_ = true;
+    min_ = std::min(min_, double(v));
+    max_ = std::max(max_, double(v));
+    if (v > 0) {
+      if (!any_positive_) min_positive_ = v, any_positive_ = true;
+      min_positive_ = std::min(min_positive_, double(v));
+    }
+  }
+}
+
+FieldRange RangeAccumulator::range() const {
+  if (!any_) throw std::runtime_error("field '" + field_ + "' has no values in cells with material in the selected frames");
+  FieldRange r;
+  r.log = log_;
+  if (log_) {
+    if (!any_positive_) {  // nothing flows anywhere: show one decade around 1e-3 of the unit
+      r.lo = 1e-4, r.hi = 1e-3;
+      return r;
+    }
+    r.hi = max_;
+    r.lo = std::max(min_positive_, max_ * 1e-4);
+    if (r.lo >= r.hi) r.lo = r.hi / 10.0;
+    return r;
+  }
+  r.lo = min_, r.hi = max_;
+  if (r.hi - r.lo <= 1e-12 * std::max(1.0, std::abs(r.hi))) {
+    const double pad = std::abs(r.hi) > 0 ? 0.05 * std::abs(r.hi) : 1.0;
+    r.lo -= pad, r.hi += pad;
+  }
+  return r;
+}
+
+std::string default_colormap(const std::string& field, const FieldRange& range) {
+  if (!range.log && range.lo < 0 && range.hi > 0) return "coolwarm";
+  if (field == "strain_rate" || field == "plastic_strain") return "magma";
+  return "viridis";
+}
+
+std::string colorbar_title(const std::string& field, bool log_scale) {
+  const FieldInfo& info = require_field(field);
+  std::string t = info.label + (info.vector ? " magnitude" : "");
+  std::string unit = info.unit == "-" ? "" : info.unit;
+  if (log_scale) unit += std::string(unit.empty() ? "" : ", ") + "log scale";
+  if (!unit.empty()) t += " (" + unit + ")";
+  return t;
+}
+
+// ---- renderer -----------------------------------------------------------------------------------
+struct FrameRenderer::Pipeline {
+  OffscreenWindow window;
+  vtkNew<vtkRenderer> field_ren;
+  vtkNew<vtkImageData> image;
+  vtkNew<vtkFloatArray> values;
+  vtkNew<vtkLookupTable> lut;
+  vtkNew<vtkImageMapToColors> to_colors;
+  vtkNew<vtkImageActor> image_actor;
+  vtkNew<vtkPolyData> outlines;
+  vtkNew<vtkPolyDataMapper> outline_mapper;
+  vtkNew<vtkActor> outline_actor;
+  vtkNew<vtkScalarBarActor> colorbar;
+  vtkNew<vtkTextActor> colorbar_title;
+  vtkNew<vtkTextActor> title;
+  vtkNew<vtkTextActor> time;
+  // side panel
+  vtkNew<vtkRenderer> panel_ren;
+  vtkNew<vtkContextActor> chart_actor;
+  vtkNew<vtkChartXY> chart;
+  std::vector<vtkSmartPointer<vtkTable>> line_tables, marker_tables;
+
+  Pipeline(int w, int h) : window(w, h) {}
+};
+
+namespace {
+constexpr double kPanelFraction = 0.38;  // of the width, when a force panel is shown
+
+int even_floor(double v) { return int(std::floor(v / 2.0)) * 2; }
+
+vtkSmartPointer<vtkTable> make_xy_table(const std::string& x_name, const std::string& y_name) {
+  auto t = vtkSmartPointer<vtkTable>::New();
+  vtkNew<vtkFloatArray> x, y;
+  x->SetName(x_name.c_str());
+  y->SetName(y_name.c_str());
+  t->AddColumn(x);
+  t->AddColumn(y);
+  return t;
+}
+
+void set_xy_rows(vtkTable* t, const std::vector<double>& x, const std::vector<double>& y) {
+  auto* cx = vtkFloatArray::SafeDownCast(t->GetColumn(0));
+  auto* cy = vtkFloatArray::SafeDownCast(t->GetColumn(1));
+  cx->SetNumberOfTuples(vtkIdType(x.size()));
+  cy->SetNumberOfTuples(vtkIdType(y.size()));
+  for (size_t k = 0; k < x.size(); ++k) {
+    cx->SetValue(vtkIdType(k), float(x[k]));
+    cy->SetValue(vtkIdType(k), float(y[k]));
+  }
+  t->Modified();
+}
+
+// Series samples with t <= time, ending with the point interpolated at `time`.
+void series_until(const ForceSeries& s, double time, std::vector<double>& x, std::vector<double>& y) {
+  x.clear(), y.clear();
+  const size_t n = std::min({s.t_s.size(), s.x.size(), s.y.size()});
+  if (n == 0) return;
+  size_t k = 0;
+  for (; k < n && s.t_s[k] <= time; ++k) x.push_back(s.x[k]), y.push_back(s.y[k]);
+  if (k == 0) {
+    x.push_back(s.x[0]), y.push_back(s.y[0]);
+  } else if (k < n && s.t_s[k] > s.t_s[k - 1]) {
+    const double w = (time - s.t_s[k - 1]) / (s.t_s[k] - s.t_s[k - 1]);
+    x.push_back(s.x[k - 1] + w * (s.x[k] - s.x[k - 1]));
+    y.push_back(s.y[k - 1] + w * (s.y[k] - s.y[k - 1]));
+  }
+}
+
+// Plain decimals sized to the range (0, 742, 1485 Pa; 0.550 for packing), exponents only for
+// very large or small values; log scales label their decades.
+std::string label_format(const FieldRange& r) {
+  if (r.log) return "%.2g";
+  const double big = std::max(std::abs(r.lo), std::abs(r.hi)), span = r.hi - r.lo;
+  if (big >= 1e5 || big < 1e-3) return "%.2e";
+  const int decimals = std::clamp(2 - int(std::floor(std::log10(span))), 0, 6);
+  return "%." + std::to_string(decimals) + "f";
+}
+
+const std::array<unsigned char, 3> kSeriesColors[] = {{31, 92, 180}, {214, 88, 20}, {40, 150, 60}, {150, 50, 160}};
+}  // namespace
+
+FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
+  require_field(style.field);
+  if (style.width < 16 || style.height < 16)
+    throw std::invalid_argument("image size " + std::to_string(style.width) + "x" + std::to_string(style.height) +
+                                " is too small (at least 16x16)");
+  if (!(style.range.hi > style.range.lo) || !std::isfinite(style.range.lo) || !std::isfinite(style.range.hi))
+    throw std::invalid_argument("colour range for '" + style.field + "' must have lo < hi, got [" +
+                                std::to_string(style.range.lo) + ", " + std::to_string(style.range.hi) + "]");
+  if (style.range.log && !(style.range.lo > 0))
+    throw std::invalid_argument("log colour range for '" + style.field + "' needs lo > 0");
+  if (style_.colormap.empty()) style_.colormap = default_colormap(style.field, style.range);
+  const Colormap& cmap = load_colormap(style_.colormap);
+
+  const int W = style.width, H = style.height;
+  p_ = std::make_unique<Pipeline>(W, H);
+  Pipeline& p = *p_;
+  const double font_scale = H / 720.0;
+  const int fa_w = style.panel ? even_floor(W * (1.0 - kPanelFraction)) : W;
+
+  // colour mapping: NaN marks cells without material
+  fill_lookup_table(cmap, p.lut);
+  p.lut->SetRange(style.range.lo, style.range.hi);
+  if (style.range.log) p.lut->SetScaleToLog10();
+  else p.lut->SetScaleToLinear();
+  p.lut->SetNanColor(style.empty_rgb[0], style.empty_rgb[1], style.empty_rgb[2], 1.0);
+  p.values->SetName(style.field.c_str());
+  p.image->GetPointData()->SetScalars(p.values);
+  p.to_colors->SetLookupTable(p.lut);
+  p.to_colors->SetOutputFormatToRGB();
+  p.to_colors->SetInputData(p.image);
+  p.image_actor->GetMapper()->SetInputConnection(p.to_colors->GetOutputPort());
+  p.image_actor->GetMapper()->BorderOn();  // cells are squares: draw the outer half cells too
+  p.image_actor->InterpolateOff();         // one flat colour per cell: resolution stays visible
+  p.field_ren->AddActor(p.image_actor);
+
+  p.outline_mapper->SetInputData(p.outlines);
+  p.outline_actor->SetMapper(p.outline_mapper);
+  p.outline_actor->GetProperty()->SetColor(style.outline_rgb[0], style.outline_rgb[1], style.outline_rgb[2]);
+  p.outline_actor->GetProperty()->SetLineWidth(float(std::max(2.0, 3.0 * font_scale)));
+  p.outline_actor->GetProperty()->LightingOff();
+  p.field_ren->AddActor(p.outline_actor);
+
+  const double text_rgb[3] = {0.05, 0.05, 0.05};
+  const int title_px = std::max(10, int(std::lround(22 * font_scale)));
+  const int label_px = std::max(8, int(std::lround(16 * font_scale)));
+
+  // layout of the field area (left part): title band, bed, colorbar band
+  const int top_band = int(std::lround(0.09 * H));
+  const int bottom_band = style.show_colorbar ? int(std::lround(0.17 * H)) : int(std::lround(0.03 * H));
+  const int side = int(std::lround(0.025 * W));
+  layout_.panel_x0 = style.panel ? fa_w : 0;
+  layout_.panel_x1 = style.panel ? W : 0;
+  layout_.time_x0 = fa_w / 2, layout_.time_x1 = fa_w - side / 2;
+  layout_.time_y0 = 0, layout_.time_y1 = top_band;
+  // colorbar band: our own title line, then the bar with its labels below
+  const int cb_x0 = int(std::lround(0.15 * fa_w)), cb_x1 = int(std::lround(0.85 * fa_w));
+  const int cb_y0 = H - bottom_band + int(std::lround(0.06 * bottom_band));
+  const int cb_title_y = H - bottom_band + int(std::lround(0.22 * bottom_band));  // centre line
+  const int bar_y0 = H - bottom_band + int(std::lround(0.40 * bottom_band));
+  const int cb_y1 = H - int(std::lround(0.04 * bottom_band));
+  layout_.colorbar_x0 = cb_x0, layout_.colorbar_x1 = cb_x1;
+  layout_.colorbar_y0 = cb_y0, layout_.colorbar_y1 = cb_y1;
+  // the bed rectangle itself is fitted per frame (render()), inside this box
+  layout_.bed_x0 = side, layout_.bed_x1 = fa_w - side;
+  layout_.bed_y0 = top_band, layout_.bed_y1 = H - bottom_band;
+
+  if (style.show_colorbar) {
+    p.colorbar->SetLookupTable(p.lut);
+    p.colorbar->SetOrientationToHorizontal();
+    p.colorbar->SetTitle("");  // VTK puts its title among the labels; ours sits above the bar
+    p.colorbar->SetNumberOfLabels(5);
+    p.colorbar->SetLabelFormat(label_format(style.range).c_str());
+    p.colorbar->UnconstrainedFontSizeOn();
+    p.colorbar->SetTextPositionToPrecedeScalarBar();  // title above, labels below the bar
+    p.colorbar->SetMaximumNumberOfColors(int(cmap.rgb.size()));
+    p.colorbar->SetBarRatio(0.32);
+    p.colorbar->SetTextPad(int(std::lround(4 * font_scale)));
+    for (vtkTextProperty* tp : {p.colorbar->GetTitleTextProperty(), p.colorbar->GetLabelTextProperty()}) {
+      tp->SetColor(text_rgb);
+      tp->ShadowOff();
+      tp->BoldOff();
+      tp->ItalicOff();
+      tp->SetFontFamilyToArial();
+    }
+    p.colorbar->GetTitleTextProperty()->SetFontSize(title_px - 2);
+    p.colorbar->GetLabelTextProperty()->SetFontSize(label_px);
+    p.colorbar->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+    p.colorbar->GetPosition2Coordinate()->SetCoordinateSystemToViewport();
+    p.colorbar->GetPositionCoordinate()->SetValue(cb_x0, H - cb_y1);
+    p.colorbar->GetPosition2Coordinate()->SetValue(cb_x1 - cb_x0, cb_y1 - bar_y0);
+    p.field_ren->AddActor2D(p.colorbar);
+    p.colorbar_title->SetInput(colorbar_title(style.field, style.range.log).c_str());
+    vtkTextProperty* tp = p.colorbar_title->GetTextProperty();
+    tp->SetFontSize(title_px - 2);
+    tp->SetColor(text_rgb);
+    tp->SetFontFamilyToArial();
+    tp->SetJustificationToCentered();
+    tp->SetVerticalJustificationToCentered();
+    p.colorbar_title->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+    p.colorbar_title->GetPositionCoordinate()->SetValue(0.5 * (cb_x0 + cb_x1), H - cb_title_y);
+    p.field_ren->AddActor2D(p.colorbar_title);
+  }
+  for (vtkTextActor* t : {p.title.Get(), p.time.Get()}) {
+    vtkTextProperty* tp = t->GetTextProperty();
+    tp->SetFontSize(title_px);
+    tp->SetColor(text_rgb);
+    tp->SetFontFamilyToArial();
+    tp->SetVerticalJustificationToCentered();
+    t->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+  }
+  p.title->GetTextProperty()->SetJustificationToLeft();
+  p.title->GetPositionCoordinate()->SetValue(side, H - top_band / 2);
+  p.time->GetTextProperty()->SetJustificationToRight();
+  p.time->GetPositionCoordinate()->SetValue(fa_w - side, H - top_band / 2);
+  if (style.show_title) p.field_ren->AddActor2D(p.title);
+  if (style.show_time) p.field_ren->AddActor2D(p.time);
+
+  p.field_ren->SetBackground(style.background_rgb[0], style.background_rgb[1], style.background_rgb[2]);
+  p.field_ren->SetViewport(0.0, 0.0, double(fa_w) / W, 1.0);
+  p.field_ren->GetActiveCamera()->ParallelProjectionOn();
+  p.window.window()->AddRenderer(p.field_ren);
+
+  if (style.panel) {
+    const ForcePanel& fp = *style.panel;
+    p.panel_ren->SetViewport(double(fa_w) / W, 0.0, 1.0, 0.97);  // a little air above the chart title
+    p.panel_ren->SetBackground(style.background_rgb[0], style.background_rgb[1], style.background_rgb[2]);
+    p.chart_actor->GetScene()->AddItem(p.chart);
+    p.panel_ren->AddActor(p.chart_actor);
+    p.window.window()->AddRenderer(p.panel_ren);
+
+    p.chart->SetTitle(fp.title);
+    p.chart->GetTitleProperties()->SetFontSize(title_px - 2);
+    p.chart->GetTitleProperties()->SetColor(text_rgb);
+    double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
+    bool any = false;
+    for (size_t s = 0; s < fp.series.size(); ++s) {
+      const ForceSeries& ser = fp.series[s];
+      for (size_t k = 0; k < std::min(ser.x.size(), ser.y.size()); ++k) {
+        if (!std::isfinite(ser.x[k]) || !std::isfinite(ser.y[k])) continue;
+        if (!any) x_lo = x_hi = ser.x[k], y_lo = y_hi = ser.y[k], any = true;
+        x_lo = std::min(x_lo, ser.x[k]), x_hi = std::max(x_hi, ser.x[k]);
+        y_lo = std::min(y_lo, ser.y[k]), y_hi = std::max(y_hi, ser.y[k]);
+      }
+      const auto& c = kSeriesColors[s % 4];
+      auto line_t = make_xy_table(fp.x_label, ser.label.empty() ? "body " + std::to_string(s) : ser.label);
+      auto mark_t = make_xy_table(fp.x_label, "now");
+      vtkPlot* line = p.chart->AddPlot(vtkChart::LINE);
+      line->SetInputData(line_t, 0, 1);
+      line->SetColor(c[0], c[1], c[2], 255);
+      line->SetWidth(float(std::max(1.5, 2.5 * font_scale)));
+      vtkPlot* mark = p.chart->AddPlot(vtkChart::POINTS);
+      mark->SetInputData(mark_t, 0, 1);
+      mark->SetColor(c[0], c[1], c[2], 255);
+      mark->SetLegendVisibility(false);
+      if (auto* pts = vtkPlotPoints::SafeDownCast(mark)) {
+        pts->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+        pts->SetMarkerSize(float(std::max(6.0, 12.0 * font_scale)));
+      }
+      p.line_tables.push_back(line_t);
+      p.marker_tables.push_back(mark_t);
+    }
+    // fixed axes over the whole series, so the plot does not jump between frames
+    y_lo = std::min(y_lo, 0.0);
+    if (!any || x_hi <= x_lo) x_hi = x_lo + 1.0;
+    if (!any || y_hi <= y_lo) y_hi = y_lo + 1.0;
+    const double y_pad = 0.05 * (y_hi - y_lo);
+    vtkAxis* ax = p.chart->GetAxis(vtkAxis::BOTTOM);
+    vtkAxis* ay = p.chart->GetAxis(vtkAxis::LEFT);
+    ax->SetTitle(fp.x_label);
+    ay->SetTitle(fp.y_label);
+    ax->SetBehavior(vtkAxis::FIXED);
+    ay->SetBehavior(vtkAxis::FIXED);
+    ax->SetRange(x_lo, x_hi);
+    ay->SetRange(y_lo < 0 ? y_lo - y_pad : y_lo, y_hi + y_pad);
+    for (vtkAxis* a : {ax, ay}) {
+      a->GetTitleProperties()->SetFontSize(label_px);
+      a->GetTitleProperties()->SetColor(text_rgb);
+      a->GetLabelProperties()->SetFontSize(label_px - 2);
+      a->GetLabelProperties()->SetColor(text_rgb);
+    }
+    p.chart->SetShowLegend(fp.series.size() > 1);
+    if (fp.series.size() > 1) p.chart->GetLegend()->GetLabelProperties()->SetFontSize(label_px - 2);
+  }
+}
+
+FrameRenderer::~FrameRenderer() = default;
+
+RgbImage FrameRenderer::render(const FieldFrame& frame) {
+  Pipeline& p = *p_;
+  const int W = style_.width, H = style_.height;
+  if (frame.nx <= 0 || frame.ny <= 0 || !(frame.dx_m > 0))
+    throw std::invalid_argument("frame at step " + std::to_string(frame.step) + " has an empty grid (nx " +
+                                std::to_string(frame.nx) + ", ny " + std::to_string(frame.ny) + ", dx " +
+                                std::to_string(frame.dx_m) + " m)");
+  std::vector<float> v = field_values(frame, style_.field);
+  if (style_.range.log) {
+    const float lo = float(style_.range.lo);
+    for (float& x : v)
+      if (!std::isnan(x) && !(x > lo)) x = lo;  // no flow (rate 0) shows as the bottom colour
+  }
+
+  // field texture: one image point per cell, at the cell centre
+  p.image->SetDimensions(frame.nx, frame.ny, 1);
+  p.image->SetSpacing(frame.dx_m, frame.dx_m, 1.0);
+  p.image->SetOrigin(frame.origin_m.x() + 0.5 * frame.dx_m, frame.origin_m.y() + 0.5 * frame.dx_m, 0.0);
+  p.values->SetNumberOfComponents(1);
+  p.values->SetNumberOfTuples(vtkIdType(v.size()));
+  std::copy(v.begin(), v.end(), p.values->GetPointer(0));
+  p.values->Modified();
+  p.image->Modified();
+
+  // fit the bed box into the field area, aspect ratio preserved
+  const int fa_w = style_.panel ? even_floor(W * (1.0 - kPanelFraction)) : W;
+  const int top_band = int(std::lround(0.09 * H));
+  const int bottom_band = style_.show_colorbar ? int(std::lround(0.17 * H)) : int(std::lround(0.03 * H));
+  const int side = int(std::lround(0.025 * W));
+  const double avail_w = fa_w - 2.0 * side, avail_h = double(H - top_band - bottom_band);
+  const double bed_w = frame.nx * frame.dx_m, bed_h = frame.ny * frame.dx_m;
+  const double ppm = std::min(avail_w / bed_w, avail_h / bed_h);
+  layout_.px_per_m = ppm;
+  layout_.bed_x0 = side + 0.5 * (avail_w - bed_w * ppm);
+  layout_.bed_x1 = layout_.bed_x0 + bed_w * ppm;
+  layout_.bed_y0 = top_band + 0.5 * (avail_h - bed_h * ppm);
+  layout_.bed_y1 = layout_.bed_y0 + bed_h * ppm;
+  layout_.bed_origin_m = frame.origin_m;
+  // camera: world point under the centre of the field viewport; parallel scale = half its height
+  const Eigen::Vector2d centre_m(frame.origin_m.x() + (0.5 * fa_w - layout_.bed_x0) / ppm,
+                                 frame.origin_m.y() + (layout_.bed_y1 - 0.5 * H) / ppm);
+  const double depth = 10.0 * std::max(bed_w, bed_h) + 1.0;
+  vtkCamera* cam = p.field_ren->GetActiveCamera();
+  cam->SetFocalPoint(centre_m.x(), centre_m.y(), 0.0);
+  cam->SetPosition(centre_m.x(), centre_m.y(), depth);
+  cam->SetViewUp(0, 1, 0);
+  cam->SetParallelScale(0.5 * H / ppm);
+  cam->SetClippingRange(0.5 * depth, 1.5 * depth);
+
+  // body outlines, just in front of the field
+  vtkNew<vtkPoints> pts;
+  vtkNew<vtkCellArray> lines;
+  const double z = 0.01 * depth;
+  for (const BodyOutline& b : frame.bodies) {
+    if (b.outline_m.size() < 2) continue;
+    std::vector<vtkIdType> ids;
+    for (const auto& q : b.outline_m) ids.push_back(pts->InsertNextPoint(q.x(), q.y(), z));
+    ids.push_back(ids.front());  // closed loop
+    lines->InsertNextCell(vtkIdType(ids.size()), ids.data());
+  }
+  p.outlines->SetPoints(pts);
+  p.outlines->SetLines(lines);
+  p.outlines->Modified();
+
+  // text
+  if (style_.show_title) {
+    const std::string t = frame.scene_name.empty() ? colorbar_title(style_.field, false)
+                                                   : frame.scene_name + ": " + find_field(style_.field)->label;
+    p.title->SetInput(t.c_str());
+  }
+  if (style_.show_time) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "t = %.*f s", std::clamp(style_.time_decimals, 0, 9), frame.time_s);
+    p.time->SetInput(buf);
+  }
+
+  // force panel up to this frame's time
+  if (style_.panel) {
+    std::vector<double> x, y;
+    for (size_t s = 0; s < style_.panel->series.size(); ++s) {
+      series_until(style_.panel->series[s], frame.time_s, x, y);
+      set_xy_rows(p.line_tables[s], x, y);
+      if (x.empty()) {
+        set_xy_rows(p.marker_tables[s], {}, {});
+      } else {
+        set_xy_rows(p.marker_tables[s], {x.back()}, {y.back()});
+      }
+    }
+    p.chart->RecalculateBounds();
+  }
+  return p.window.capture();
+}
+
+}  // namespace furrow::render

@@ -1,0 +1,115 @@
+// One field of a FieldFrame drawn as an image: the field as a colour-mapped texture (cells without
+// material in a neutral grey, so the free surface shows), a colorbar titled with label and unit
+// from field_registry(), a time stamp, body outlines, and optionally a side panel plotting force
+// against displacement up to the frame's time. Off-screen (OSMesa), no display needed.
+#pragma once
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/fields.hpp"
+#include "render/image_io.hpp"
+
+namespace furrow::render {
+
+// Colour range of a field, fixed by the caller for a whole movie (never per frame).
+struct FieldRange {
+  double lo = 0.0, hi = 1.0;
+  bool log = false;  // log10 mapping (strain rate); then 0 < lo < hi
+};
+
+// The values drawn for `field`: the scalar as stored, or |v| for velocity. Inactive cells are NaN.
+// Throws std::runtime_error if the frame does not hold the field (naming the ones it has).
+std::vector<float> field_values(const FieldFrame& frame, const std::string& field);
+
+// Accumulates the range of a field over frames (active cells only).
+class RangeAccumulator {
+ public:
+  explicit RangeAccumulator(const std::string& field);
+  void add(const FieldFrame& frame);
+  // Linear fields: [min, max] (widened if flat). Log fields (field_registry().log_scale): hi = max,
+  // lo = max(smallest positive value, hi / 10^4) so static regions (rate 0) do not stretch the
+  // scale over dozens of empty decades. Throws if no active value was seen.
+  FieldRange range() const;
+
+ private:
+  std::string field_;
+  bool log_ = false;
+  double min_ = 0, max_ = 0, min_positive_ = 0;
+  bool any_ = false, any_positive_ = false;
+};
+
+// Colormap used when the caller names none: diverging (coolwarm) for a range spanning zero,
+// magma for strain rate and plastic strain, viridis for the rest.
+std::string default_colormap(const std::string& field, const FieldRange& range);
+
+// Force against displacement of one body, sampled at times t_s (ascending).
+struct ForceSeries {
+  std::string label;  // body name
+  std::vector<double> t_s, x, y;  // x, y in the panel's display units
+};
+
+struct ForcePanel {
+  std::string title = "Force on bodies";
+  std::string x_label = "displacement (mm)";
+  std::string y_label = "resisting force (N/m)";
+  std::vector<ForceSeries> series;
+};
+
+struct FrameStyle {
+  int width = 1280, height = 720;  // even sizes for movies
+  std::string field;               // registry name
+  FieldRange range;
+  std::string colormap;            // empty: default_colormap(field, range)
+  bool show_colorbar = true;
+  bool show_title = true;
+  bool show_time = true;
+  int time_decimals = 3;
+  std::optional<ForcePanel> panel;  // side panel (right ~38% of the image)
+  std::array<float, 3> empty_rgb{0.82f, 0.82f, 0.82f};     // cells with no material
+  std::array<float, 3> outline_rgb{0.0f, 0.9f, 1.0f};      // body outlines (cyan: in no colormap)
+  std::array<float, 3> background_rgb{1.0f, 1.0f, 1.0f};
+};
+
+// Where things landed in the last image, in pixels with the top-left corner as origin.
+struct FrameLayout {
+  double bed_x0 = 0, bed_y0 = 0, bed_x1 = 0, bed_y1 = 0;  // the bed box (field texture) edges
+  double px_per_m = 0;
+  Eigen::Vector2d bed_origin_m{0, 0};                  // world point at (bed_x0, bed_y1)
+  int colorbar_x0 = 0, colorbar_y0 = 0, colorbar_x1 = 0, colorbar_y1 = 0;
+  int time_x0 = 0, time_y0 = 0, time_x1 = 0, time_y1 = 0;  // box the time stamp is drawn in
+  int panel_x0 = 0, panel_x1 = 0;                          // 0, 0 when there is no panel
+  // Pixel (x right, y down) of a world point.
+  Eigen::Vector2d to_pixel(const Eigen::Vector2d& p_m) const {
+    return {bed_x0 + (p_m.x() - bed_origin_m.x()) * px_per_m, bed_y1 - (p_m.y() - bed_origin_m.y()) * px_per_m};
+  }
+};
+
+// Keeps its VTK pipeline between frames, so a movie pays set-up once. Not thread-safe.
+class FrameRenderer {
+ public:
+  // Throws std::invalid_argument for an unknown field (listing the valid ones), a bad size or
+  // range, or an unknown colormap.
+  explicit FrameRenderer(const FrameStyle& style);
+  ~FrameRenderer();
+  FrameRenderer(const FrameRenderer&) = delete;
+  FrameRenderer& operator=(const FrameRenderer&) = delete;
+
+  RgbImage render(const FieldFrame& frame);
+  const FrameLayout& layout() const { return layout_; }
+  const FrameStyle& style() const { return style_; }
+
+ private:
+  struct Pipeline;
+  FrameStyle style_;
+  FrameLayout layout_;
+  std::unique_ptr<Pipeline> p_;
+};
+
+// Colorbar title: "Pressure (Pa)", "Velocity magnitude (m/s)", "Packing fraction" (unit "-").
+std::string colorbar_title(const std::string& field, bool log_scale);
+
+}  // namespace furrow::render

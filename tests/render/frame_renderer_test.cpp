@@ -1,0 +1,247 @@
+// FrameRenderer on synthetic frames with known fields (DISPLAY unset). Set FURROW_TEST_DUMP=DIR
+// to keep the rendered images for a look.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "render/colormap.hpp"
+#include "render/frame_renderer.hpp"
+#include "tests/render/capture_output.hpp"
+#include "tests/render/synthetic_frames.hpp"
+
+using namespace furrow;
+using namespace furrow::render;
+
+namespace {
+// Bed 0.4 m x 0.25 m (160 x 100 cells of 2.5 mm), material up to 0.2 m, a plate across the surface.
+constexpr int kNx = 160, kNy = 100;
+constexpr double kDx = 0.0025, kSurface = 0.2;
+constexpr double kPlateX0 = 0.20, kPlateX1 = 0.30, kPlateY0 = 0.17, kPlateY1 = 0.23;
+
+FieldFrame test_frame() {
+  FieldFrame f = test::hydrostatic_frame(kNx, kNy, kDx, kSurface);
+  f.bodies.push_back(test::box_body("plate", kPlateX0, kPlateY0, kPlateX1, kPlateY1));
+  return f;
+}
+
+double max_pressure() { return test::kRhoBulk_kg_m3 * test::kG_m_s2 * kSurface; }
+
+void dump(const RgbImage& img, const std::string& name) {
+  if (const char* d = std::getenv("FURROW_TEST_DUMP")) {
+    std::filesystem::create_directories(d);
+    write_png(img, (std::filesystem::path(d) / (name + ".png")).string(), true);
+  }
+}
+
+bool near_rgb(const uint8_t* px, const std::array<float, 3>& c, int tol) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(int(px[k]) - int(std::lround(255 * c[k]))) > tol) return false;
+  return true;
+}
+}  // namespace
+
+TEST(FrameRenderer, HydrostaticPressureColoursRiseMonotonicallyWithDepth) {
+  FrameStyle style;
+  style.field = "pressure";
+  style.range = {0.0, max_pressure(), false};
+  FieldFrame frame = test_frame();
+  RgbImage img;
+  FrameLayout L;
+  const std::string noise = test::capture_output([&] {
+    FrameRenderer r(style);
+    img = r.render(frame);
+    L = r.layout();
+  });
+  dump(img, "pressure");
+  EXPECT_FALSE(test::mentions_gl_trouble(noise)) << noise;
+  ASSERT_EQ(img.width, 1280);
+  ASSERT_EQ(img.height, 720);
+  EXPECT_EQ(style.colormap, "");  // the style passed in is not modified
+  const Colormap& cmap = load_colormap("viridis");
+
+  // Aspect ratio of the bed is kept.
+  EXPECT_NEAR((L.bed_x1 - L.bed_x0) / (L.bed_y1 - L.bed_y0), (kNx * kDx) / (kNy * kDx), 1e-9);
+
+  // Down a vertical line at x = 0.08 m (clear of the plate), from 1 px below the free surface to
+  // 1 px above the bottom: every pixel is a viridis colour, its index never decreases with depth,
+  // and it matches the cell's pressure (index = floor(256 p / p_max), within 2 for cell edges).
+  const int px = int(L.to_pixel({0.08, 0.0}).x());
+  const int y_surface = int(std::ceil(L.to_pixel({0.0, kSurface}).y()));
+  const int y_bottom = int(std::floor(L.to_pixel({0.0, 0.0}).y()));
+  ASSERT_GT(y_bottom - y_surface, 200);
+  int previous = -1, checked = 0;
+  for (int y = y_surface + 1; y < y_bottom - 1; ++y) {
+    double dist = 0;
+    const int idx = cmap.nearest_index(img.at(px, y), &dist);
+    ASSERT_LE(dist, 3.0) << "pixel (" << px << "," << y << ") is not a colormap colour";
+    ASSERT_GE(idx, previous) << "colour index fell with depth at y = " << y;
+    previous = idx;
+    const double y_m = (L.bed_y1 - (y + 0.5)) / L.px_per_m;
+    const double cell_centre_m = (std::floor(y_m / kDx) + 0.5) * kDx;
+    const double expect = std::min(255.0, std::floor(256.0 * (kSurface - cell_centre_m) / kSurface));
+    EXPECT_NEAR(idx, expect, 2.0) << "at depth " << kSurface - y_m << " m";
+    ++checked;
+  }
+  EXPECT_GT(checked, 200);
+  // Just below the surface the colour is near the bottom of the map, at the bed bottom near the top.
+  EXPECT_LE(cmap.nearest_index(img.at(px, y_surface + 2)), 8);
+  EXPECT_GE(cmap.nearest_index(img.at(px, y_bottom - 2)), 247);
+
+  // Above the free surface (no material): the neutral empty colour.
+  const int y_air = int(L.to_pixel({0.0, 0.5 * (kSurface + kNy * kDx)}).y());
+  EXPECT_TRUE(near_rgb(img.at(px, y_air), style.empty_rgb, 1));
+
+  // Body outline: cyan pixels lie on the plate's edges (within 3 px) and nowhere else.
+  const Eigen::Vector2d a = L.to_pixel({kPlateX0, kPlateY1}), b = L.to_pixel({kPlateX1, kPlateY0});
+  int on_edges = 0, elsewhere = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      if (!near_rgb(img.at(x, y), style.outline_rgb, 40)) continue;
+      const double dx_out = std::max({a.x() - x - 0.5, x + 0.5 - b.x(), 0.0});
+      const double dy_out = std::max({a.y() - y - 0.5, y + 0.5 - b.y(), 0.0});
+      const double d_in = std::min({x + 0.5 - a.x(), b.x() - x - 0.5, y + 0.5 - a.y(), b.y() - y - 0.5});
+      const double dist = (dx_out > 0 || dy_out > 0) ? std::hypot(dx_out, dy_out) : d_in;
+      (dist <= 3.0 ? on_edges : elsewhere) += 1;
+    }
+  const double perimeter_px = 2.0 * ((b.x() - a.x()) + (b.y() - a.y()));
+  EXPECT_GT(on_edges, perimeter_px) << "outline should be at least 1 px wide all round";
+  EXPECT_EQ(elsewhere, 0);
+
+  // Colorbar: most of the 256 colours appear in its box.
+  std::vector<bool> seen(cmap.rgb.size(), false);
+  for (int y = L.colorbar_y0; y < L.colorbar_y1; ++y)
+    for (int x = L.colorbar_x0; x < L.colorbar_x1; ++x) {
+      double dist = 0;
+      const int idx = cmap.nearest_index(img.at(x, y), &dist);
+      if (dist < 1.5) seen[idx] = true;
+    }
+  EXPECT_GT(std::count(seen.begin(), seen.end(), true), 200);
+  // Colorbar title/labels and the time stamp: dark text pixels in their boxes.
+  auto dark_pixels = [&](int x0, int y0, int x1, int y1) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) n += img.at(x, y)[0] < 90 && img.at(x, y)[1] < 90 && img.at(x, y)[2] < 90;
+    return n;
+  };
+  EXPECT_GT(dark_pixels(L.colorbar_x0, L.colorbar_y0, L.colorbar_x1, L.colorbar_y1), 300);
+  EXPECT_GT(dark_pixels(L.time_x0, L.time_y0, L.time_x1, L.time_y1), 100);
+}
+
+TEST(FrameRenderer, SameFrameTwiceGivesIdenticalImages) {
+  FrameStyle style;
+  style.field = "pressure";
+  style.width = 640, style.height = 360;
+  style.range = {0.0, max_pressure(), false};
+  FrameRenderer r(style);
+  const FieldFrame f = test_frame();
+  const RgbImage a = r.render(f);
+  const RgbImage b = r.render(f);
+  EXPECT_EQ(a.rgb, b.rgb);
+  FrameRenderer r2(style);
+  EXPECT_EQ(r2.render(f).rgb, a.rgb);
+}
+
+TEST(FrameRenderer, StrainRateUsesLogScale) {
+  // strain rate = 10^(4 x / W - 3): on a log scale over [1e-3, 10] the colour index is linear in x.
+  FrameStyle style;
+  style.field = "strain_rate";
+  style.range = {1e-3, 10.0, true};
+  FieldFrame f = test_frame();
+  f.bodies.clear();
+  FrameRenderer r(style);
+  const RgbImage img = r.render(f);
+  dump(img, "strain_rate");
+  const FrameLayout& L = r.layout();
+  const Colormap& cmap = load_colormap("magma");  // default for strain rate
+  const int y = int(L.to_pixel({0.0, 0.5 * kSurface}).y());
+  int checked = 0;
+  for (int x = int(std::ceil(L.bed_x0)) + 1; x < int(L.bed_x1) - 1; x += 7) {
+    const double x_m = (x + 0.5 - L.bed_x0) / L.px_per_m;
+    const double cell_x = (std::floor(x_m / kDx) + 0.5) * kDx;
+    const double expect = std::min(255.0, std::floor(256.0 * (cell_x / (kNx * kDx))));
+    double dist = 0;
+    EXPECT_NEAR(cmap.nearest_index(img.at(x, y), &dist), expect, 2.0) << "x = " << x_m << " m";
+    EXPECT_LE(dist, 3.0);
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(FrameRenderer, ForcePanelGrowsWithTime) {
+  FrameStyle style;
+  style.field = "pressure";
+  style.range = {0.0, max_pressure(), false};
+  ForcePanel panel;
+  ForceSeries s;
+  s.label = "plate";
+  for (int k = 0; k <= 100; ++k) {
+    s.t_s.push_back(0.01 * k);
+    s.x.push_back(1.0 * k);              // mm
+    s.y.push_back(50.0 * std::sqrt(k));  // N/m
+  }
+  panel.series.push_back(s);
+  style.panel = panel;
+  FrameRenderer r(style);
+  FieldFrame f = test_frame();
+  const FrameLayout& L = r.layout();
+  auto series_pixels = [&](const RgbImage& img) {
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = L.panel_x0; x < L.panel_x1; ++x) {
+        const uint8_t* p = img.at(x, y);
+        n += std::abs(p[0] - 31) < 40 && std::abs(p[1] - 92) < 40 && std::abs(p[2] - 180) < 40 && p[2] > p[0] + 80;
+      }
+    return n;
+  };
+  f.time_s = 0.2;
+  const RgbImage early = r.render(f);
+  f.time_s = 0.9;
+  const RgbImage late = r.render(f);
+  dump(late, "panel");
+  ASSERT_GT(L.panel_x1, L.panel_x0);
+  // the bed is still drawn with its aspect ratio in the narrower field area
+  EXPECT_LE(L.bed_x1, L.panel_x0);
+  EXPECT_NEAR((L.bed_x1 - L.bed_x0) / (L.bed_y1 - L.bed_y0), 0.4 / 0.25, 1e-9);
+  const int n_early = series_pixels(early), n_late = series_pixels(late);
+  EXPECT_GT(n_early, 50);
+  EXPECT_GT(n_late, n_early + 100) << "the curve must extend as time advances";
+}
+
+TEST(FrameRenderer, RejectsUnknownFieldListingValidOnes) {
+  FrameStyle style;
+  style.field = "temperature";
+  try {
+    FrameRenderer r(style);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("pressure"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("temperature"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FrameRenderer, RangeAccumulatorUsesActiveCellsAndLogFloor) {
+  const FieldFrame f = test_frame();
+  RangeAccumulator p("pressure");
+  p.add(f);
+  const FieldRange rp = p.range();
+  EXPECT_FALSE(rp.log);
+  // cell centres: shallowest 1.25 mm deep, deepest 198.75 mm
+  EXPECT_NEAR(rp.lo, test::kRhoBulk_kg_m3 * test::kG_m_s2 * 0.5 * kDx, 1e-2);
+  EXPECT_NEAR(rp.hi, test::kRhoBulk_kg_m3 * test::kG_m_s2 * (kSurface - 0.5 * kDx), 1e-1);
+  RangeAccumulator s("strain_rate");
+  s.add(f);
+  const FieldRange rs = s.range();
+  EXPECT_TRUE(rs.log);
+  EXPECT_NEAR(std::log10(rs.hi), 4.0 * (kNx - 0.5) / kNx - 3.0, 1e-5);
+  EXPECT_NEAR(std::log10(rs.lo), 4.0 * 0.5 / kNx - 3.0, 1e-5);  // above hi/1e4, so the data minimum
+  RangeAccumulator v("velocity");
+  v.add(f);
+  // |(0.03, -0.04)| = 0.05 everywhere: a flat field gets a +-5% range so it still maps
+  EXPECT_NEAR(v.range().lo, 0.0475, 1e-6);
+  EXPECT_NEAR(v.range().hi, 0.0525, 1e-6);
+  EXPECT_EQ(colorbar_title("pressure", false), "Pressure (Pa)");
+  EXPECT_EQ(colorbar_title("packing_fraction", false), "Packing fraction");
+  EXPECT_EQ(colorbar_title("velocity", false), "Velocity magnitude (m/s)");
+}
