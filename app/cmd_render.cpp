@@ -1,8 +1,15 @@
 // `furrow render` and `furrow demo`: argument handling only; drawing lives in render/.
+#include <climits>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "app/commands.hpp"
+#include "engine/field_store.hpp"
+#include "render/colormap.hpp"
+#include "render/field_movie.hpp"
+#include "render/force_series.hpp"
 #include "render/image_io.hpp"
 #include "render/test_scene.hpp"
 
@@ -10,16 +17,187 @@ namespace fs = std::filesystem;
 
 namespace furrow::cli {
 
-static int todo(const Parsed& p) {
-  std::cerr << "furrow " << p.command->name << ": not implemented yet\n";
-  return 1;
+namespace {
+
+// Whole string as a number, else UsageError naming the option.
+double parse_number(const std::string& s, const std::string& option) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || !std::isfinite(v))
+    throw UsageError(option + ": expected a number, got '" + s + "'");
+  return v;
 }
 
-Command command_render() {
-  return {"render", "re-render stored frames to PNG or MP4", "furrow render RUN_DIR [options]", "", {}, 1, 1, todo};
+long long parse_int(const std::string& s, const std::string& option) {
+  char* end = nullptr;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (s.empty() || *end != '\0') throw UsageError(option + ": expected a whole number, got '" + s + "'");
+  return v;
 }
 
-static int demo_main(const Parsed& p) {
+void parse_size(const std::string& s, int* w, int* h) {
+  const size_t x = s.find('x');
+  if (x == std::string::npos) throw UsageError("--size: expected WxH, e.g. 1280x720, got '" + s + "'");
+  const long long ww = parse_int(s.substr(0, x), "--size"), hh = parse_int(s.substr(x + 1), "--size");
+  if (ww < 16 || hh < 16 || ww > 8192 || hh > 8192)
+    throw UsageError("--size: width and height must be in 16..8192, got '" + s + "'");
+  *w = int(ww), *h = int(hh);
+}
+
+long long frame_number(const std::string& path) {
+  const std::string stem = fs::path(path).stem().string();  // frame_00042
+  return std::stoll(stem.substr(stem.find('_') + 1));
+}
+
+// --frames a:b[:step] on frame numbers, both ends included; "a:" to the end, ":b" from the start,
+// "a" alone is one frame.
+std::vector<std::string> select_frames(const std::vector<std::string>& all, const std::string& spec) {
+  if (spec.empty()) return all;
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t c = spec.find(':'); ; c = spec.find(':', start)) {
+    parts.push_back(spec.substr(start, c == std::string::npos ? std::string::npos : c - start));
+    if (c == std::string::npos) break;
+    start = c + 1;
+  }
+  if (parts.size() > 3) throw UsageError("--frames: expected a:b[:step], got '" + spec + "'");
+  long long a = parts[0].empty() ? LLONG_MIN : parse_int(parts[0], "--frames");
+  long long b = parts.size() == 1 ? a : (parts[1].empty() ? LLONG_MAX : parse_int(parts[1], "--frames"));
+  const long long step = parts.size() == 3 ? parse_int(parts[2], "--frames") : 1;
+  if (step < 1) throw UsageError("--frames: step must be >= 1, got '" + spec + "'");
+  if (a > b) throw UsageError("--frames: first frame after last in '" + spec + "'");
+  std::vector<std::string> out;
+  long long taken = 0;
+  for (const auto& p : all) {
+    const long long n = frame_number(p);
+    if (n < a || n > b) continue;
+    if (taken++ % step == 0) out.push_back(p);
+  }
+  if (out.empty()) {
+    std::string have = all.empty() ? "none" : std::to_string(frame_number(all.front())) + ".." +
+                                                  std::to_string(frame_number(all.back()));
+    throw UsageError("--frames " + spec + " selects no frame (stored frames: " + have + ")");
+  }
+  return out;
+}
+
+// Evenly spread subset of at most n frames (first and last kept).
+std::vector<std::string> spread(const std::vector<std::string>& v, size_t n) {
+  if (v.size() <= n) return v;
+  std::vector<std::string> out;
+  for (size_t k = 0; k < n; ++k) out.push_back(v[size_t(std::lround(double(k) * double(v.size() - 1) / double(n - 1)))]);
+  return out;
+}
+
+std::string all_fields() {
+  std::string s;
+  for (const auto& f : field_registry()) s += (s.empty() ? "" : ", ") + f.name;
+  return s;
+}
+
+// Default outputs go to the next free name; a path the user gave is refused if taken (unless
+// --overwrite).
+std::string choose_output(const Parsed& p, const fs::path& default_path, bool* overwrite) {
+  *overwrite = p.has("--overwrite");
+  if (p.has("--out")) {
+    const std::string out = p.get("--out");
+    if (fs::exists(out) && !*overwrite)
+      throw std::runtime_error(out + " already exists; choose another --out or pass --overwrite");
+    return out;
+  }
+  return *overwrite ? default_path.string() : render::next_free_path(default_path.string());
+}
+
+int render_main(const Parsed& p) {
+  const std::string run_dir = p.positional[0];
+  if (!fs::is_directory(run_dir)) {
+    std::cerr << "furrow render: run directory '" << run_dir << "' does not exist\n";
+    return 1;
+  }
+  if (!p.has("--field")) throw UsageError("--field NAME is required (fields: " + all_fields() + ")");
+  const std::string field = p.get("--field");
+  if (!find_field(field)) {
+    std::cerr << "furrow render: unknown field '" << field << "' (valid fields: " << all_fields() << ")\n";
+    return 2;
+  }
+  if (p.has("--png") && p.has("--contact-sheet")) throw UsageError("--png and --contact-sheet exclude each other");
+
+  render::FrameStyle style;
+  style.field = field;
+  if (p.has("--size")) parse_size(p.get("--size"), &style.width, &style.height);
+  if (p.has("--colormap")) {
+    style.colormap = p.get("--colormap");
+    render::load_colormap(style.colormap);  // unknown name: error listing the known ones
+  }
+  const double fps = p.has("--fps") ? parse_number(p.get("--fps"), "--fps") : 10.0;
+  if (!(fps > 0)) throw UsageError("--fps must be > 0");
+
+  const fs::path frames_dir = fs::path(run_dir) / "frames";
+  if (!fs::is_directory(frames_dir)) {
+    std::cerr << "furrow render: " << run_dir << " has no frames/ folder (is it a run directory from 'furrow run'?)\n";
+    return 1;
+  }
+  std::vector<std::string> frames = select_frames(list_frames(run_dir), p.get("--frames"));
+  if (frames.empty()) {
+    std::cerr << "furrow render: no frame_*.vdb files in " << frames_dir.string() << "\n";
+    return 1;
+  }
+  const bool sheet = p.has("--contact-sheet");
+  if (sheet && !p.has("--frames")) frames = spread(frames, 12);
+
+  // one fixed range over the frames drawn
+  const render::FrameScan scan = render::scan_frames(frames, field);
+  style.range = scan.range;
+  style.time_decimals = scan.time_decimals;
+  if (p.has("--range")) {
+    const std::string r = p.get("--range");
+    const size_t c = r.find(':');
+    if (c == std::string::npos) throw UsageError("--range: expected LO:HI, got '" + r + "'");
+    style.range.lo = parse_number(r.substr(0, c), "--range");
+    style.range.hi = parse_number(r.substr(c + 1), "--range");
+    if (!(style.range.hi > style.range.lo)) throw UsageError("--range: LO must be below HI, got '" + r + "'");
+    if (style.range.log && style.range.lo <= 0)
+      throw UsageError("--range: " + field + " is drawn on a log scale, LO must be > 0");
+  }
+  const fs::path forces = fs::path(run_dir) / "forces.csv";
+  if (!p.has("--no-panel") && !sheet && fs::exists(forces)) {
+    render::ForcePanel panel = render::read_force_panel(forces.string());
+    if (!panel.series.empty()) style.panel = panel;
+  }
+
+  char range_text[128];
+  std::snprintf(range_text, sizeof range_text, "%s range %.4g..%.4g %s%s", field.c_str(), style.range.lo,
+                style.range.hi, find_field(field)->unit.c_str(), style.range.log ? " (log)" : "");
+  bool overwrite = false;
+  if (p.has("--png")) {
+    const std::string dir = choose_output(p, fs::path(run_dir) / "renders" / field, &overwrite);
+    const auto written = render::render_pngs(frames, style, dir, overwrite);
+    std::cout << dir << "  (" << written.size() << " PNG, " << style.width << "x" << style.height << ", "
+              << range_text << ")\n";
+  } else if (sheet) {
+    const std::string out = choose_output(p, fs::path(run_dir) / "renders" / (field + "_contact_sheet.png"), &overwrite);
+    if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
+    const int columns = p.has("--columns") ? int(parse_int(p.get("--columns"), "--columns")) : 0;
+    if (columns < 0) throw UsageError("--columns must be >= 1");
+    if (!p.has("--size")) style.width = 1920, style.height = 1080;
+    const render::RgbImage img = render::render_contact_sheet(frames, style, columns);
+    render::write_png(img, out, overwrite);
+    std::cout << out << "  (" << frames.size() << " frames, " << img.width << "x" << img.height << ", " << range_text
+              << ")\n";
+  } else {
+    if (style.width % 2 || style.height % 2)
+      throw UsageError("--size: movies need even width and height (H.264, yuv420p), got " +
+                       std::to_string(style.width) + "x" + std::to_string(style.height));
+    const std::string out = choose_output(p, fs::path(run_dir) / "movies" / (field + ".mp4"), &overwrite);
+    if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
+    render::render_movie(frames, style, out, fps, overwrite);
+    std::cout << out << "  (" << frames.size() << " frames at " << fps << " fps, " << style.width << "x"
+              << style.height << ", " << range_text << ")\n";
+  }
+  return 0;
+}
+
+int demo_main(const Parsed& p) {
   const fs::path dir = fs::path(p.get("--out", "out")) / "demo";
   fs::create_directories(dir);
   // Keep earlier results: pick test_scene_2.png, _3, ... when the name is taken.
@@ -27,6 +205,47 @@ static int demo_main(const Parsed& p) {
   render::write_png(render::render_test_scene(1280, 720), path);
   std::cout << path << "\n";
   return 0;
+}
+
+}  // namespace
+
+Command command_render() {
+  return {"render",
+          "re-render stored frames to an MP4, PNGs or a contact sheet",
+          "furrow render RUN_DIR --field NAME [--frames a:b[:step]] [--size WxH] [--png | --contact-sheet] [--out PATH]",
+          "Draws one field of the frames stored in RUN_DIR/frames/*.vdb, off-screen (no display needed).\n"
+          "The colour range is fixed over all selected frames (min..max over cells with material; strain\n"
+          "rate on a log scale from max/10^4 up to its max) unless --range is given. Cells without material\n"
+          "are grey, bodies are outlined in cyan, and each image carries a colorbar with the field's unit and\n"
+          "the time stamp. Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
+          "for each body, the resisting force -F.d (d = unit direction of its travel from first to last\n"
+          "position; Fy for a plate pushed down) against its displacement from its first position.\n"
+          "\n"
+          "Outputs (default: a movie):\n"
+          "  movie            RUN_DIR/movies/<field>.mp4 (H.264, yuv420p; even sizes)\n"
+          "  --png            RUN_DIR/renders/<field>/frame_NNNNN.png, one per frame\n"
+          "  --contact-sheet  RUN_DIR/renders/<field>_contact_sheet.png: up to 12 frames spread over the run\n"
+          "                  (or exactly those picked by --frames), each tile labelled with its time (1920 wide)\n"
+          "Nothing is overwritten: a default name that is taken becomes <name>_2, _3, ...; a taken --out\n"
+          "PATH is an error unless --overwrite is given. Prints the path written.\n"
+          "\n"
+          "--frames selects by frame number (frame_00042.vdb is 42), both ends included: '10:50',\n"
+          "'10:50:5' (every 5th), '20:' (to the end), ':30', or '42' (one frame).",
+          {{"--field", true, false, "field to draw: " + all_fields(), "NAME"},
+           {"--frames", true, false, "frame numbers a:b[:step], both ends included (default: all)", "SPEC"},
+           {"--size", true, false, "image size (default 1280x720; contact sheet: sheet width 1920, tiles WxH-shaped)", "WxH"},
+           {"--png", false, false, "write one PNG per frame instead of a movie"},
+           {"--contact-sheet", false, false, "write one PNG with the frames as a grid of tiles"},
+           {"--columns", true, false, "contact-sheet columns (default: about square)", "N"},
+           {"--out", true, false, "output file (movie, sheet) or folder (--png)", "PATH"},
+           {"--overwrite", false, false, "replace an existing output"},
+           {"--range", true, false, "fixed colour range instead of the frames' min..max", "LO:HI"},
+           {"--colormap", true, false, "viridis, magma or coolwarm (default: by field)", "NAME"},
+           {"--fps", true, false, "movie frames per second (default 10)", "N"},
+           {"--no-panel", false, false, "leave out the force panel"}},
+          1,
+          1,
+          render_main};
 }
 
 Command command_demo() {

@@ -89,7 +89,30 @@ std::vector<float> field_values(const FieldFrame& frame, const std::string& fiel
 RangeAccumulator::RangeAccumulator(const std::string& field) : field_(field), log_(require_field(field).log_scale) {}
 
 void RangeAccumulator::add(const FieldFrame& frame) {
-  for (float v : field_values(frame, field_)) {
+  std::vector<float> vals = field_values(frame, field_);
+  // per-frame robust bounds: the 0.5th and 99.5th percentiles of the cells with material
+  std::vector<float> finite, positive;
+  finite.reserve(vals.size());
+  for (float v : vals)
+    if (std::isfinite(v)) {
+      finite.push_back(v);
+      if (v > 0) positive.push_back(v);
+    }
+  auto percentile = [](std::vector<float>& v, double q) {
+    const size_t k = std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5)));
+    std::nth_element(v.begin(), v.begin() + long(k), v.end());
+    return double(v[k]);
+  };
+  if (!finite.empty()) {
+    const double lo = percentile(finite, kTailFraction), hi = percentile(finite, 1.0 - kTailFraction);
+    robust_lo_ = any_ ? std::min(robust_lo_, lo) : lo;
+    robust_hi_ = any_ ? std::max(robust_hi_, hi) : hi;
+  }
+  if (!positive.empty()) {
+    const double hi = percentile(positive, 1.0 - kTailFraction);
+    robust_hi_positive_ = any_positive_ ? std::max(robust_hi_positive_, hi) : hi;
+  }
+  for (float v : vals) {
     if (!std::isfinite(v)) continue;
     if (!any_) min_ = max_ = v, any_ = true;
     min_ = std::min(min_, double(v));
@@ -101,6 +124,11 @@ void RangeAccumulator::add(const FieldFrame& frame) {
   }
 }
 
+FieldRange RangeAccumulator::exact_range() const {
+  if (!any_) throw std::runtime_error("field '" + field_ + "' has no values in cells with material in the selected frames");
+  return {min_, max_, log_};
+}
+
 FieldRange RangeAccumulator::range() const {
   if (!any_) throw std::runtime_error("field '" + field_ + "' has no values in cells with material in the selected frames");
   FieldRange r;
@@ -110,12 +138,12 @@ FieldRange RangeAccumulator::range() const {
       r.lo = 1e-4, r.hi = 1e-3;
       return r;
     }
-    r.hi = max_;
-    r.lo = std::max(min_positive_, max_ * 1e-4);
+    r.hi = robust_hi_positive_;
+    r.lo = std::max(min_positive_, r.hi * 1e-4);
     if (r.lo >= r.hi) r.lo = r.hi / 10.0;
     return r;
   }
-  r.lo = min_, r.hi = max_;
+  r.lo = robust_lo_, r.hi = robust_hi_;
   if (r.hi - r.lo <= 1e-12 * std::max(1.0, std::abs(r.hi))) {
     const double pad = std::abs(r.hi) > 0 ? 0.05 * std::abs(r.hi) : 1.0;
     r.lo -= pad, r.hi += pad;
@@ -199,6 +227,9 @@ void series_until(const ForceSeries& s, double time, std::vector<double>& x, std
   for (; k < n && s.t_s[k] <= time; ++k) x.push_back(s.x[k]), y.push_back(s.y[k]);
   if (k == 0) {
     x.push_back(s.x[0]), y.push_back(s.y[0]);
+  }
+  if (k <= 1 && n > 0) {
+    x.push_back(x.back()), y.push_back(y.back());  // a line needs two points, even at the start
   } else if (k < n && s.t_s[k] > s.t_s[k - 1]) {
     const double w = (time - s.t_s[k - 1]) / (s.t_s[k] - s.t_s[k - 1]);
     x.push_back(s.x[k - 1] + w * (s.x[k] - s.x[k - 1]));
@@ -235,7 +266,7 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
   const int W = style.width, H = style.height;
   p_ = std::make_unique<Pipeline>(W, H);
   Pipeline& p = *p_;
-  const double font_scale = H / 720.0;
+  const double font_scale = style.font_scale > 0 ? style.font_scale : H / 720.0;
   const int fa_w = style.panel ? even_floor(W * (1.0 - kPanelFraction)) : W;
 
   // colour mapping: NaN marks cells without material
@@ -343,12 +374,15 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
 
   if (style.panel) {
     const ForcePanel& fp = *style.panel;
-    p.panel_ren->SetViewport(double(fa_w) / W, 0.0, 1.0, 0.97);  // a little air above the chart title
+    p.panel_ren->SetViewport(double(fa_w) / W, 0.0, 1.0, 1.0);
     p.panel_ren->SetBackground(style.background_rgb[0], style.background_rgb[1], style.background_rgb[2]);
     p.chart_actor->GetScene()->AddItem(p.chart);
     p.panel_ren->AddActor(p.chart_actor);
     p.window.window()->AddRenderer(p.panel_ren);
 
+    // fill the panel but leave a little air above the chart title
+    p.chart->SetLayoutStrategy(vtkChart::FILL_RECT);
+    p.chart->SetSize(vtkRectf(0.f, 0.f, float(W - fa_w), float(H - std::lround(0.03 * H))));
     p.chart->SetTitle(fp.title);
     p.chart->GetTitleProperties()->SetFontSize(title_px - 2);
     p.chart->GetTitleProperties()->SetColor(text_rgb);

@@ -30,15 +30,23 @@ class RangeAccumulator {
  public:
   explicit RangeAccumulator(const std::string& field);
   void add(const FieldFrame& frame);
-  // Linear fields: [min, max] (widened if flat). Log fields (field_registry().log_scale): hi = max,
-  // lo = max(smallest positive value, hi / 10^4) so static regions (rate 0) do not stretch the
-  // scale over dozens of empty decades. Throws if no active value was seen.
+  // Robust to a few extreme cells (a pressure spike under a plate's edge would otherwise turn the
+  // whole bed into the bottom colour): in each frame take the 0.5th and 99.5th percentiles of the
+  // cells with material; the range runs from the lowest to the highest of those over all frames.
+  // Cells beyond it show in the end colours. Linear fields are widened if flat. Log fields
+  // (field_registry().log_scale): hi from the positive values as above, lo = max(smallest positive
+  // value, hi / 10^4), so static regions (rate 0) do not stretch the scale over empty decades.
+  // Throws if no active value was seen.
   FieldRange range() const;
+  // Plain min and max over the cells with material.
+  FieldRange exact_range() const;
+  static constexpr double kTailFraction = 0.005;
 
  private:
   std::string field_;
   bool log_ = false;
   double min_ = 0, max_ = 0, min_positive_ = 0;
+  double robust_lo_ = 0, robust_hi_ = 0, robust_hi_positive_ = 0;
   bool any_ = false, any_positive_ = false;
 };
 
@@ -68,6 +76,7 @@ struct FrameStyle {
   bool show_title = true;
   bool show_time = true;
   int time_decimals = 3;
+  double font_scale = 0.0;  // text size relative to a 720-pixel-high image; 0: height / 720
   std::optional<ForcePanel> panel;  // side panel (right ~38% of the image)
   std::array<float, 3> empty_rgb{0.82f, 0.82f, 0.82f};     // cells with no material
   std::array<float, 3> outline_rgb{0.0f, 0.9f, 1.0f};      // body outlines (cyan: in no colormap)

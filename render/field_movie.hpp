@@ -1,0 +1,42 @@
+// Re-rendering stored frames (OpenVDB files from the field store): movies, single PNGs and
+// contact sheets, all with one colour range fixed over the frames involved.
+#pragma once
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "render/frame_renderer.hpp"
+
+namespace furrow::render {
+
+struct FrameScan {
+  FieldRange range;             // over every active cell of every frame scanned
+  std::vector<double> times_s;  // one per frame
+  int time_decimals = 3;        // enough to tell consecutive frames apart (at least 3)
+};
+
+// Reads each frame once for its range and time. Throws naming the file that fails to read or
+// lacks the field.
+FrameScan scan_frames(const std::vector<std::string>& frame_paths, const std::string& field);
+
+// Decimals that tell consecutive times apart: max(3, digits of the smallest spacing).
+int time_decimals_for(const std::vector<double>& times_s);
+
+using FrameProgress = std::function<void(size_t done, size_t total)>;
+
+// Renders every frame with `style` and encodes them at `fps` into `out_path` (see MovieWriter:
+// even sizes, atomic publish, no overwrite unless asked).
+void render_movie(const std::vector<std::string>& frame_paths, const FrameStyle& style, const std::string& out_path,
+                  double fps, bool overwrite, const FrameProgress& progress = {});
+
+// One PNG per frame in `out_dir` (created if missing), named like the frame file
+// (frame_00042.vdb -> frame_00042.png). Returns the paths written.
+std::vector<std::string> render_pngs(const std::vector<std::string>& frame_paths, const FrameStyle& style,
+                                     const std::string& out_dir, bool overwrite, const FrameProgress& progress = {});
+
+// The frames as tiles in a grid of `columns` (0: about square), each tile labelled with its time,
+// above one shared colorbar. style.width is the sheet width; tiles keep style's aspect ratio.
+RgbImage render_contact_sheet(const std::vector<std::string>& frame_paths, const FrameStyle& style, int columns,
+                              const FrameProgress& progress = {});
+
+}  // namespace furrow::render
