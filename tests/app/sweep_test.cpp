@@ -302,3 +302,34 @@ TEST_F(SweepCli, LinkedKeysTakeTheSameValueAndRangesIncludeTheirEnd) {
     EXPECT_DOUBLE_EQ(scene["bodies"][1]["friction"].get<double>(), std::stod(values[i]));
   }
 }
+
+TEST_F(SweepCli, FigureFollowsWhatWasSwept) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string figure;
+  };
+  const std::string plate2 =
+      R"(bodies.2={"name":"plate2","shape":{"type":"box","size_m":[0.02,0.01]},"start_m":[0.078,0.0555],)"
+      R"("motion":{"type":"constant_velocity","velocity_m_s":[0,-0.1]}})";
+  const std::vector<Case> cases = {
+      // the rod leads once the plate stands still: its depth was swept
+      {{"--vary", "bodies.rod.start_m.1=0.03,0.035", "--set", "bodies.plate.motion.velocity_m_s=[0,0]"},
+       "drag_lift_vs_depth"},
+      // two moving plates whose gap changes
+      {{"--vary", "bodies.plate2.start_m.0=0.078,0.083", "--set", plate2}, "pair_separation"},
+      // anything else
+      {{"--vary", "bodies.plate.friction=0.2,0.4"}, "generic"},
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    const std::string out = path("fig" + std::to_string(n++));
+    std::vector<std::string> args = {"sweep", path("tiny.json"), "--out", out, "--set", "solver.end_displacement_m=0.01",
+                                     "--set", "outputs.average_window.to_m=0.01"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = run(args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto sj = nlohmann::json::parse(read_text(out + "/sweep.json"));
+    EXPECT_EQ(sj["figure"], c.figure) << c.args[1];
+    EXPECT_TRUE(fs::exists(out + "/sweep.png")) << c.args[1];
+  }
+}
