@@ -198,8 +198,23 @@ RgbImage render_figure(const PlotFigure& fig) {
       tp->SetBackgroundColor(1, 1, 1);
       tp->SetBackgroundOpacity(0.85);
       p.notes->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-      // inside the plot area, clear of the axis labels on the left and the title on top
-      p.notes->GetPositionCoordinate()->SetValue(0.17, 0.90);
+      // inside the plot area, in the corner (top left, top right, bottom left; the legend sits
+      // bottom right) that the data crowd least
+      auto frac = [](double v, const std::array<double, 2>& r, bool log) {
+        return log ? std::log(v / r[0]) / std::log(r[1] / r[0]) : (v - r[0]) / (r[1] - r[0]);
+      };
+      int crowd[3] = {0, 0, 0};
+      for (size_t i = 0; i < xs.size(); ++i) {
+        const double fx = frac(xs[i], xr, panel.log_x), fy = frac(ys[i], yr, panel.log_y);
+        crowd[0] += fx < 0.6 && fy > 0.6;
+        crowd[1] += fx > 0.4 && fy > 0.6;
+        crowd[2] += fx < 0.6 && fy < 0.4;
+      }
+      const int best = int(std::min_element(crowd, crowd + 3) - crowd);
+      if (best == 1) tp->SetJustificationToRight();
+      if (best == 2) tp->SetVerticalJustificationToBottom();
+      const double nx = best == 1 ? 0.96 : 0.14, ny = best == 2 ? 0.16 : 0.90;
+      p.notes->GetPositionCoordinate()->SetValue(nx, ny);
       p.renderer->AddActor2D(p.notes);
     }
     pipes.push_back(std::move(pp));
