@@ -84,9 +84,7 @@ class ForceStats {
   }
   void add(const Simulation& sim) {
     const double t = sim.time_s(), d = sim.lead_body_travel_m(), dt = sim.last_dt_s();
-    const bool by_disp = out_.average_from_m >= 0.0 && out_.average_to_m > out_.average_from_m;
-    const bool in_window = by_disp ? (d >= out_.average_from_m && d <= out_.average_to_m)
-                                   : (t >= out_.average_from_s && (out_.average_to_s < 0.0 || t <= out_.average_to_s));
+    const bool in_window = in_average_window(out_, t, d);
     for (size_t b = 0; b < bodies_.size(); ++b) {
       const Vec2 f = sim.bodies()[b].force_N_per_m;
       auto& s = bodies_[b];
