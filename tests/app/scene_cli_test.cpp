@@ -1,6 +1,8 @@
 // `furrow templates / new / validate` run as a user would: the real binary, exit codes, stdout and
 // stderr, files on disk.
 #include <gtest/gtest.h>
+
+#include "tests/app/cli_fixture.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,54 +16,15 @@
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-#ifndef FURROW_CLI_PATH
-#error "FURROW_CLI_PATH must name the furrow binary (set by CMakeLists.txt)"
-#endif
-
 namespace {
 
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
+using furrow::cli_test::Result;
+using furrow::cli_test::read_text;
+namespace cli_test = furrow::cli_test;
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-class SceneCli : public ::testing::Test {
+class SceneCli : public cli_test::CliFixture {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("furrow_scene_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  Result run(const std::vector<std::string>& args) {
-    std::string cmd = quote(FURROW_CLI_PATH);
-    for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
-    const int rc = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-    r.out = read_text(dir_ / "stdout");
-    r.err = read_text(dir_ / "stderr");
-    return r;
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-  fs::path dir_;
+  SceneCli() : CliFixture("furrow_scene_cli_") {}
 };
 
 }  // namespace

@@ -1,6 +1,8 @@
 // `furrow sweep` run as a user would: the real binary on a tiny scene, its run directories,
 // sweep.csv (columns, units, normalizations), sweep.json, sweep.png, and its errors.
 #include <gtest/gtest.h>
+
+#include "tests/app/cli_fixture.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,11 +16,11 @@
 
 namespace fs = std::filesystem;
 
-#ifndef FURROW_CLI_PATH
-#error "FURROW_CLI_PATH must name the furrow binary (set by CMakeLists.txt)"
-#endif
-
 namespace {
+
+using furrow::cli_test::Result;
+using furrow::cli_test::read_text;
+namespace cli_test = furrow::cli_test;
 
 // A 0.1 x 0.05 m bed at dx 5 mm (about 800 particles): a plate pushed down 15 mm from 0.5 mm above
 // the surface and a rod dragged sideways; each run takes well under a second.
@@ -37,24 +39,6 @@ const char* kTinyScene = R"({
   ],
   "outputs": {"average_window": {"from_m": 0.0085, "to_m": 0.0155}}
 })";
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
 
 std::vector<std::string> split(const std::string& line, char sep) {
   std::vector<std::string> out(1);
@@ -92,29 +76,13 @@ Csv read_csv(const fs::path& p) {
   return c;
 }
 
-class SweepCli : public ::testing::Test {
+class SweepCli : public cli_test::CliFixture {
  protected:
+  SweepCli() : CliFixture("furrow_sweep_cli_") {}
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("furrow_sweep_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    CliFixture::SetUp();
     std::ofstream(dir_ / "tiny.json") << kTinyScene;
   }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  Result run(const std::vector<std::string>& args) {
-    std::string cmd = quote(FURROW_CLI_PATH);
-    for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string());
-    const int rc = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-    r.out = read_text(dir_ / "stdout");
-    r.err = read_text(dir_ / "stderr");
-    return r;
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
   // Nothing but the scene and the captured output in the test directory.
   void expect_nothing_written() const {
     for (const auto& e : fs::directory_iterator(dir_)) {
@@ -123,7 +91,6 @@ class SweepCli : public ::testing::Test {
     }
   }
 
-  fs::path dir_;
 };
 
 constexpr double kPi = 3.14159265358979323846;
