@@ -99,25 +99,12 @@ namespace {
 // halves the steps. chi = 5 as in the caption of the paper's figure 7, which shows the
 // fluctuations (its text says 2.5): at phi_i = 0.63 the friction softens from 0.55 to 0.40.
 Scene plowing_scene(double phi_i, double dx, double travel_m, double bed_w, double bed_h, double air_m) {
-  Scene s;
-  s.name = "plowing_test";
   const double plate_h = 0.08, depth = 0.05;
-  s.domain = {bed_w, bed_h + air_m, dx};
-  s.solver.end_time_s = 100.0;
+  Scene s = bed_scene(dpm_material("glass_beads", 2520.0, 0.40, 5.0, 5.0e6), bed_w, bed_h, air_m, dx, 100.0, phi_i);
+  s.name = "plowing_test";
   s.solver.end_displacement_m = travel_m;
   s.solver.threads = 1;  // the two beds run side by side, one core each
-  s.materials.push_back(dpm_material("glass_beads", 2520.0, 0.40, 5.0, 5.0e6));
-  Bed b;
-  b.material = "glass_beads";
-  b.min_m = Vec2(0.0, 0.0);
-  b.max_m = Vec2(bed_w, bed_h);
-  b.packing_fraction = phi_i;
-  s.beds.push_back(b);
   s.effects.dilatancy = true;
-  s.walls.left = {Wall::Kind::Slip, 0.0};
-  s.walls.right = {Wall::Kind::Slip, 0.0};
-  s.walls.bottom = {Wall::Kind::Friction, 0.4};
-  s.walls.top = {Wall::Kind::Open, 0.0};
   Body p = plate(0.03, plate_h, 0.1, bed_h - depth, Vec2(0.2, 0.0));
   s.bodies.push_back(p);
   return s;
@@ -258,23 +245,10 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 // is tested on medians: early = the first 12.5 mm of intrusion (0.3 L), late = 30-50 mm.
 TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
   const double dx = 0.0025, bed_w = 0.25, bed_h = 0.16, gap = 0.002, v = 0.15, travel = 0.05;
-  Scene s;
+  Scene s = bed_scene(dpm_material("poppy_seeds", 1100.0, 0.53, 5.0, 2.0e6), bed_w, bed_h, 0.03, dx, 10.0, 0.55);
   s.name = "loose_intrusion_test";
-  s.domain = {bed_w, bed_h + 0.03, dx};
-  s.solver.end_time_s = 10.0;
   s.solver.end_displacement_m = gap + travel;
-  s.materials.push_back(dpm_material("poppy_seeds", 1100.0, 0.53, 5.0, 2.0e6));
-  Bed b;
-  b.material = "poppy_seeds";
-  b.min_m = Vec2(0.0, 0.0);
-  b.max_m = Vec2(bed_w, bed_h);
-  b.packing_fraction = 0.55;
-  s.beds.push_back(b);
   s.effects.dilatancy = true;
-  s.walls.left = {Wall::Kind::Slip, 0.0};
-  s.walls.right = {Wall::Kind::Slip, 0.0};
-  s.walls.bottom = {Wall::Kind::Friction, 0.4};
-  s.walls.top = {Wall::Kind::Open, 0.0};
   s.bodies.push_back(plate(0.04, 0.02, 0.5 * bed_w, bed_h + gap, Vec2(0.0, -v)));
   Simulation sim(s);
   RasterSpec raster;

@@ -12,6 +12,7 @@
 
 #include "engine/scene.hpp"
 #include "engine/simulation.hpp"
+#include "tests/engine/test_scenes.hpp"
 
 namespace furrow::paper {
 
@@ -19,34 +20,13 @@ constexpr double kRhoG = 2520.0, kPhi = 0.60, kG = 9.81;
 constexpr double kRhoD = kRhoG * kPhi;  // 1512 kg/m^3, the paper's rho_d
 constexpr double kPi = 3.14159265358979323846;
 
-inline Material glass_beads(double mu_s) {
-  Material m;
-  m.name = "glass_beads";
-  m.model = MaterialModel::NDPM;
-  m.grain_density_kg_m3 = kRhoG;
-  m.phi_c = kPhi;
-  m.mu = mu_s;
-  return m;  // E 5 MPa, nu 0.3: the engine's "just stiff enough" defaults
-}
+inline Material glass_beads(double mu_s) { return test_scenes::glass_beads(mu_s); }
 
 // A bed filling [0, width] x [0, depth] with air above, slip sides and a rough floor, one thread.
 inline Scene bed(double width_m, double depth_m, double air_m, double dx_m, double mu_s) {
-  Scene s;
-  s.name = "paper_case";
-  s.domain = {width_m, depth_m + air_m, dx_m};
-  s.solver.end_time_s = 100.0;  // runs end on end_displacement_m
-  s.solver.threads = 1;         // one simulation per core (see run_all)
-  s.materials.push_back(glass_beads(mu_s));
-  Bed b;
-  b.material = "glass_beads";
-  b.min_m = Vec2(0.0, 0.0);
-  b.max_m = Vec2(width_m, depth_m);
-  b.packing_fraction = kPhi;
-  s.beds.push_back(b);
-  s.walls.left = {Wall::Kind::Slip, 0.0};
-  s.walls.right = {Wall::Kind::Slip, 0.0};
-  s.walls.bottom = {Wall::Kind::Friction, 0.4};
-  s.walls.top = {Wall::Kind::Open, 0.0};
+  Scene s = test_scenes::bed_scene(glass_beads(mu_s), width_m, depth_m, air_m, dx_m, 100.0, kPhi);
+  s.name = "paper_case";  // runs end on end_displacement_m
+  s.solver.threads = 1;   // one simulation per core (see run_all)
   return s;
 }
 

@@ -16,24 +16,31 @@ inline Material glass_beads(double mu = 0.4) {
   return m;
 }
 
-// A bed of width w and depth h filling the bottom of a domain (w x h+air), slip walls, friction floor.
-inline Scene bed_scene(double w, double h, double air, double dx, double end_time_s) {
+// A bed of material m, width w and depth h at packing phi filling the bottom of a domain
+// (w x h+air): slip side walls, friction floor, open top.
+inline Scene bed_scene(const Material& m, double w, double h, double air, double dx, double end_time_s,
+                       double packing_fraction) {
   Scene s;
   s.name = "test_bed";
   s.domain = {w, h + air, dx};
   s.solver.end_time_s = end_time_s;
-  s.materials.push_back(glass_beads());
+  s.materials.push_back(m);
   Bed b;
-  b.material = "glass_beads";
+  b.material = m.name;
   b.min_m = Vec2(0.0, 0.0);
   b.max_m = Vec2(w, h);
-  b.packing_fraction = 0.60;
+  b.packing_fraction = packing_fraction;
   s.beds.push_back(b);
   s.walls.left = {Wall::Kind::Slip, 0.0};
   s.walls.right = {Wall::Kind::Slip, 0.0};
   s.walls.bottom = {Wall::Kind::Friction, 0.4};
   s.walls.top = {Wall::Kind::Open, 0.0};
   return s;
+}
+
+// The same with NDPM glass beads at phi_c.
+inline Scene bed_scene(double w, double h, double air, double dx, double end_time_s) {
+  return bed_scene(glass_beads(), w, h, air, dx, end_time_s, 0.60);
 }
 
 // A box plate of size (L, t) starting with its bottom `gap` above the bed surface, moving at v.
