@@ -191,12 +191,16 @@ TEST(PaperCase2, SinglePlateOnsetForceScalesAsL2AndDeepForceAsL) {
 // contact reaches ~1.5 cells beyond each plate, so a narrower gap is numerically closed.
 // Each bed: the plate system's span, 1.5 spans of bed on each side and one span under the window
 // (a floor 0.7 spans under the plates raised the force of a 2 L plate).
-constexpr double kPairDx = 0.0025, kPairFrom = 0.07, kPairTo = 0.09;
+constexpr double kPairDx = 0.0025;
+struct DepthWindow {
+  double from_m, to_m;
+};
+constexpr DepthWindow kPeakWindow{0.07, 0.09};
 
 // s_over_L < 0: one plate of width L (s -> infinity); 0: one plate of width 2 L; else two plates.
-Scene pair_scene(double L, double s_over_L) {
+Scene pair_scene(double L, double s_over_L, DepthWindow win) {
   const double span = s_over_L < 0 ? L : s_over_L == 0 ? 2 * L : (2 + s_over_L) * L;
-  const double W = 4.0 * span, H = kPairTo + span, x0 = 0.5 * W;
+  const double W = 4.0 * span, H = win.to_m + span, x0 = 0.5 * W;
   std::vector<double> centres;
   if (s_over_L > 0) {
     centres.push_back(x0 - 0.5 * (s_over_L * L + L));
@@ -204,14 +208,14 @@ Scene pair_scene(double L, double s_over_L) {
   } else {
     centres.push_back(x0);
   }
-  return plates_scene(W, H, kPairDx, s_over_L == 0 ? 2 * L : L, centres, kPairTo);
+  return plates_scene(W, H, kPairDx, s_over_L == 0 ? 2 * L : L, centres, win.to_m);
 }
 
 // Per-plate window-mean drag over rho_d g z L w (z the window's middle).
-double pair_normalized(const Trace& t, double L, double s_over_L) {
+double pair_normalized(const Trace& t, double L, double s_over_L, DepthWindow win) {
   const double plates = s_over_L > 0 ? 2.0 : s_over_L == 0 ? 2.0 : 1.0;
-  const double F = depth_mean(depth_trace(t, 0.5 * kPairDx), kPairFrom, kPairTo) / plates;
-  const double Fn = F / (kRhoD * kG * 0.5 * (kPairFrom + kPairTo) * L);
+  const double F = depth_mean(depth_trace(t, 0.5 * kPairDx), win.from_m, win.to_m) / plates;
+  const double Fn = F / (kRhoD * kG * 0.5 * (win.from_m + win.to_m) * L);
   std::printf("case 2 pair: L %.4f m  s/L %4s  per-plate drag %6.1f N/m  F/(rho_d g z L w) %.2f  (%zu particles, "
               "%lld steps, %.1f s)\n",
               L, s_over_L < 0 ? "inf" : std::to_string(s_over_L).substr(0, 4).c_str(), F, Fn, t.particles,
@@ -224,10 +228,10 @@ TEST(PaperCase2, PlatePairDragPeaksAtSmallSeparation) {
   const double L = 0.025;
   const std::vector<double> s_over_L = {-1.0, 0.0, 0.3, 0.6};
   std::vector<Scene> scenes;
-  for (double r : s_over_L) scenes.push_back(pair_scene(L, r));
+  for (double r : s_over_L) scenes.push_back(pair_scene(L, r, kPeakWindow));
   const std::vector<Trace> traces = run_all(scenes);
   std::vector<double> Fn;
-  for (size_t i = 0; i < s_over_L.size(); ++i) Fn.push_back(pair_normalized(traces[i], L, s_over_L[i]));
+  for (size_t i = 0; i < s_over_L.size(); ++i) Fn.push_back(pair_normalized(traces[i], L, s_over_L[i], kPeakWindow));
   const double far = Fn[0], touching = Fn[1];
   const auto peak = std::max_element(Fn.begin() + 2, Fn.end());
   std::printf("case 2 pair: peak %.2f at s/L %.2f; s = 0: %.2f (peak %+.1f%%), s -> inf: %.2f (peak %+.1f%%)\n", *peak,
@@ -237,44 +241,35 @@ TEST(PaperCase2, PlatePairDragPeaksAtSmallSeparation) {
   EXPECT_GE(*peak, 1.05 * far);
 }
 
-// The paper's scaling: in the F ~ z L regime F/(rho_d g z L w) is a function of s/L alone, the same
-// for every L at a given window. Here it is not: with two widths at one window the per-plate
-// excess of a pair over a lone plate, F_pair - F_inf, does not grow like z L but stays ~ 9 rho_d g L^2
-// (an N_gamma-like, near-surface share), so its normalized form falls like L/z. Measured peak
-// excess over s -> inf against z/L for 8..15-cell plates and three windows: 0.47 (z/L 1.7),
-// 0.44 (2.1), 0.40 (2.3), 0.37 (2.5), 0.23 (3.2), 0.24 (3.5): one curve in z/L whatever the
-// resolution, so not a resolution effect, and the same plate (10 cells) gives 0.37 at z/L 2.5 and
-// 0.23 at 3.2. At this window (L = 0.025 / 0.0375 m): s -> inf 10.16 / 10.37 (+2%), s = 0 10.41 /
-// 11.88 (+14%), s/L 0.3 12.53 / 14.92 (+19%). Skipped (with this run's numbers) while that holds.
+// The paper's scaling (its eq. 11): where F ~ z L, F/(rho_d g z L w) is a function of s/L alone, the
+// same for every L. That regime needs depth: the per-plate excess of a pair over a lone plate has
+// an N_gamma-like share ~ 9 rho_d g L^2 that does not grow with z, so at shallow windows the curves
+// split by L/z. Measured peak excess over s -> inf against z/L (8..15-cell plates, one curve
+// whatever the resolution): 0.47 (z/L 1.7), 0.40 (2.3), 0.37 (2.5), 0.23 (3.2), 0.24 (3.5). At the
+// peak test's window (0.07..0.09 m) L = 0.025 vs 0.0375 m differ by up to 19%; from z/L 3.2 on
+// (window 0.12..0.14 m, z/L 3.5 and 5.2) they agree: measured when chosen s -> inf 9.94 / 10.02,
+// s = 0 10.37 / 10.17, s/L 0.3 11.95 / 12.12 (worst 1.9%; 170 s on 2 cores).
+constexpr DepthWindow kCollapseWindow{0.12, 0.14};
 TEST(PaperCase2, PlatePairCurvesCollapseOverWidth) {
   const std::vector<double> widths_m = {0.025, 0.0375}, s_over_L = {-1.0, 0.0, 0.3};
   std::vector<Scene> scenes;
   for (double L : widths_m)
-    for (double r : s_over_L) scenes.push_back(pair_scene(L, r));
+    for (double r : s_over_L) scenes.push_back(pair_scene(L, r, kCollapseWindow));
   const std::vector<Trace> traces = run_all(scenes);
   std::vector<double> a, b;
   for (size_t k = 0; k < s_over_L.size(); ++k) {
-    a.push_back(pair_normalized(traces[k], widths_m[0], s_over_L[k]));
-    b.push_back(pair_normalized(traces[s_over_L.size() + k], widths_m[1], s_over_L[k]));
+    a.push_back(pair_normalized(traces[k], widths_m[0], s_over_L[k], kCollapseWindow));
+    b.push_back(pair_normalized(traces[s_over_L.size() + k], widths_m[1], s_over_L[k], kCollapseWindow));
   }
-  std::string measured;
-  double worst = 0.0;
   for (size_t k = 0; k < a.size(); ++k) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%ss/L %s: %.2f vs %.2f (%+.1f%%)", k ? "; " : "",
-                  s_over_L[k] < 0 ? "inf" : std::to_string(s_over_L[k]).substr(0, 3).c_str(), a[k], b[k],
-                  100 * (b[k] / a[k] - 1));
-    measured += buf;
-    worst = std::max(worst, std::abs(b[k] / a[k] - 1));
+    std::printf("case 2 pair collapse: s/L %s: %.2f vs %.2f (%+.1f%%)\n",
+                s_over_L[k] < 0 ? "inf" : std::to_string(s_over_L[k]).substr(0, 3).c_str(), a[k], b[k],
+                100 * (b[k] / a[k] - 1));
+    EXPECT_NEAR(b[k], a[k], 0.10 * a[k]) << "s/L point " << k;
   }
-  std::printf("case 2 pair collapse: %s\n", measured.c_str());
-  // the lone plates are the single-plate claim (F ~ L deep) and must agree whatever happens below
-  EXPECT_NEAR(b[0], a[0], 0.10 * a[0]);
-  if (worst > 0.10)
-    GTEST_SKIP() << "pair curves do not collapse over L within 10% at this window (F/(rho_d g z L w), L = "
-                 << widths_m[0] << " vs " << widths_m[1] << " m): " << measured
-                 << ". The pair excess scales like rho_d g L^2, not z L (see the comment above); reported to the engine author.";
-  for (size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(b[k], a[k], 0.10 * a[k]) << "point " << k;
+  // and the curve keeps its interior peak at this depth
+  EXPECT_GE(a[2], 1.05 * std::max(a[0], a[1]));
+  EXPECT_GE(b[2], 1.05 * std::max(b[0], b[1]));
 }
 
 }  // namespace
