@@ -70,8 +70,14 @@ TEST(PaperCase1, CylinderDragGrowsLinearlyWithDepth) {
 // --vary bodies.cylinder.start_m.1=0.12,0.10 --set solver.end_displacement_m=0.02 --set
 // outputs.average_window.from_m=0.005 --set outputs.average_window.to_m=0.02`, 5.5 min on 2 cores):
 // drag 19.5 -> 30.2 N/m (+55%), lift 3.8 -> 5.4 N/m (+42%) from 10 D to 15 D. Lift stays 0.15..0.20
-// of the drag at every depth from 2.5 D to 15 D: it does not level off. That run costs more than this
-// suite's budget, so it runs only with FURROW_LONG_PAPER_TESTS=1; otherwise the test is skipped.
+// of the drag at every depth from 2.5 D to 15 D: it does not level off. What the flow shows at 15 D
+// (strain-rate and pressure frames): the cylinder leaves a ~1.5 mm open tunnel that closes only by
+// the roof falling under gravity (0.03 m/s), in a halo of open particles (phi 0.55..0.5995 < phi_d,
+// next to points at 0.6001 carrying 1..2 kPa), so the back of the cylinder sees little pressure.
+// Tried: taking each point's volume rate from the cell-centre divergence (filters the grid's
+// checkerboard): the lift then levels off (2.87 -> 2.92 N/m) but so does the drag (14.1 -> 14.9 N/m),
+// so it was not kept. That run costs more than this suite's budget, so it runs only with
+// FURROW_LONG_PAPER_TESTS=1; otherwise the test is skipped.
 TEST(PaperCase1, CylinderLiftLevelsOffAtDepth) {
   if (!std::getenv("FURROW_LONG_PAPER_TESTS"))
     GTEST_SKIP() << "lift does not level off in this solver at dx = D/4 (paper bed, 20 mm of drag: from 10 D "
