@@ -176,22 +176,42 @@ void Simulation::clear_grid() {
   });
 }
 
-// Counting sort of particle indices by strip of kStripCells cell columns.
+// Counting sort of particle indices by strip of kStripCells cell columns, in fixed chunks so it
+// runs on every core yet gives the serial order (by strip, then index) for any thread count.
 void Simulation::sort_particles() {
   const size_t n = p_.size();
   const int strips = g_.nx / kStripCells + 3;
-  strip_start_.assign(strips + 1, 0);
+  constexpr size_t kChunks = 64;
+  const size_t chunk = (n + kChunks - 1) / kChunks;
   scratch_u32_.resize(n);
+  chunk_counts_.assign(kChunks * size_t(strips), 0);  // [chunk][strip]
   const double inv = 1.0 / g_.dx;
-  for (size_t i = 0; i < n; ++i) {
-    const int s = std::clamp(int(std::floor(p_.x[i] * inv)) / kStripCells + 1, 0, strips - 1);
-    scratch_u32_[i] = uint32_t(s);
-    ++strip_start_[s + 1];
+  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
+    uint32_t* count = &chunk_counts_[c * size_t(strips)];
+    for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) {
+      const int s = std::clamp(int(std::floor(p_.x[i] * inv)) / kStripCells + 1, 0, strips - 1);
+      scratch_u32_[i] = uint32_t(s);
+      ++count[s];
+    }
+  });
+  // exclusive prefix over (strip, chunk): each chunk's first slot within each strip
+  strip_start_.assign(strips + 1, 0);
+  uint32_t total = 0;
+  for (int s = 0; s < strips; ++s) {
+    strip_start_[s] = total;
+    for (size_t c = 0; c < kChunks; ++c) {
+      uint32_t& slot = chunk_counts_[c * size_t(strips) + size_t(s)];
+      const uint32_t k = slot;
+      slot = total;
+      total += k;
+    }
   }
-  std::partial_sum(strip_start_.begin(), strip_start_.end(), strip_start_.begin());
+  strip_start_[strips] = total;
   order_.resize(n);
-  std::vector<uint32_t> fill(strip_start_.begin(), strip_start_.end() - 1);
-  for (size_t i = 0; i < n; ++i) order_[fill[scratch_u32_[i]]++] = uint32_t(i);
+  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
+    uint32_t* fill = &chunk_counts_[c * size_t(strips)];
+    for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) order_[fill[scratch_u32_[i]]++] = uint32_t(i);
+  });
 }
 
 template <class K, bool Flip>
@@ -527,7 +547,8 @@ size_t Simulation::state_bytes() const {
                         &p_.strain_rate})
     b += a->capacity() * sizeof(double);
   b += p_.material.capacity() + g_.node.capacity() * sizeof(GridNode);
-  b += (order_.capacity() + strip_start_.capacity() + scratch_u32_.capacity()) * sizeof(uint32_t);
+  b += (order_.capacity() + strip_start_.capacity() + scratch_u32_.capacity() + chunk_counts_.capacity()) *
+       sizeof(uint32_t);
   return b;
 }
 

@@ -122,7 +122,7 @@ class Simulation {
   // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
   static constexpr int kStripCells = 4;
   std::vector<uint32_t> order_, strip_start_;
-  std::vector<uint32_t> scratch_u32_;
+  std::vector<uint32_t> scratch_u32_, chunk_counts_;
   mutable std::vector<double> rho_g_cache_;
   void (Simulation::*p2g_)() = nullptr;
   void (Simulation::*g2p_)() = nullptr;
