@@ -210,7 +210,8 @@ void Simulation::sort_particles() {
   order_.resize(n);
   tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
     uint32_t* fill = &chunk_counts_[c * size_t(strips)];
-    for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) order_[fill[scratch_u32_[i]]++] = uint32_t(i);
+    for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i)
+      order_[fill[scratch_u32_[i]]++] = uint32_t(i);
   });
 }
 

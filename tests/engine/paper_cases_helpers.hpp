@@ -20,11 +20,9 @@ constexpr double kRhoG = 2520.0, kPhi = 0.60, kG = 9.81;
 constexpr double kRhoD = kRhoG * kPhi;  // 1512 kg/m^3, the paper's rho_d
 constexpr double kPi = 3.14159265358979323846;
 
-inline Material glass_beads(double mu_s) { return test_scenes::glass_beads(mu_s); }
-
 // A bed filling [0, width] x [0, depth] with air above, slip sides and a rough floor, one thread.
 inline Scene bed(double width_m, double depth_m, double air_m, double dx_m, double mu_s) {
-  Scene s = test_scenes::bed_scene(glass_beads(mu_s), width_m, depth_m, air_m, dx_m, 100.0, kPhi);
+  Scene s = test_scenes::bed_scene(test_scenes::glass_beads(mu_s), width_m, depth_m, air_m, dx_m, 100.0, kPhi);
   s.name = "paper_case";  // runs end on end_displacement_m
   s.solver.threads = 1;   // one simulation per core (see run_all)
   return s;

@@ -81,8 +81,8 @@ TEST(PaperCase1, CylinderDragGrowsLinearlyWithDepth) {
 // part of the lift is body friction: same 0.09 m bed at dx = D/4, 10 D -> 15 D, mu_f 0.35: drag
 // 19.6 -> 28.4, lift 3.89 -> 5.27 N/m (+36%); mu_f 0: drag 17.3 -> 28.4, lift 3.00 -> 2.15 N/m
 // (-28%). Material slides up the front face more than down it (it refills the tunnel from above),
-// and mu_f times a pressure ~ z turns that into a lift ~ z. That run costs more than this suite's budget, so it runs only with
-// FURROW_LONG_PAPER_TESTS=1; otherwise the test is skipped.
+// and mu_f times a pressure ~ z turns that into a lift ~ z. That run costs more than this suite's
+// budget, so it runs only with FURROW_LONG_PAPER_TESTS=1; otherwise the test is skipped.
 TEST(PaperCase1, CylinderLiftLevelsOffAtDepth) {
   if (!std::getenv("FURROW_LONG_PAPER_TESTS"))
     GTEST_SKIP() << "lift does not level off in this solver at dx = D/4 (paper bed, 20 mm of drag: from 10 D "

@@ -110,8 +110,9 @@ TEST(SceneTemplates, PaperGeometry) {
     const Scene s = load_template("two_plates");
     ASSERT_EQ(s.bodies.size(), 2u);
     const auto &a = s.bodies[0], &b = s.bodies[1];
-    EXPECT_NEAR((b.start_m.x() - 0.5 * b.shape.size_m.x()) - (a.start_m.x() + 0.5 * a.shape.size_m.x()), 0.04, 1e-9);
-    EXPECT_GE(0.04 / s.domain.dx_m, 4.0 - 1e-9);
+    const double gap_m = (b.start_m.x() - 0.5 * b.shape.size_m.x()) - (a.start_m.x() + 0.5 * a.shape.size_m.x());
+    EXPECT_NEAR(gap_m, 0.04, tol);
+    EXPECT_GE(gap_m / s.domain.dx_m, 4.0 - 1e-9);
     EXPECT_NEAR(0.5 * (a.start_m.x() + b.start_m.x()), 0.6, tol);
     EXPECT_EQ(a.start_m.y(), b.start_m.y());
   }
