@@ -18,16 +18,28 @@ namespace {
 // saturates beyond |z| ~ 10 D at this resolution and at 8 cells per D alike (dx 1 mm: 13 -> 12.5
 // N/m from 10 D to 15 D; dx 0.5 mm: 15.2 -> 15.5 N/m), because the particle-level volume noise
 // of nearly pure FLIP opens ("separates") much of the sheared material around the cylinder. With
-// 0.9 the deep drag is the same at dx 1 mm and 0.5 mm (17.4 / 18.9 N/m at 10 D) and the shallow
-// drag matches the default's within 4% (3.4 vs 3.3 N/m at 2.5 D, dx 0.5 mm). Pure APIC (0) adds a
-// numerical viscosity that doubles the deep drag (39 N/m at 15 D).
-constexpr double kD = 0.004, kCylDx = 0.001;
+// 0.9 the deep drag is the same at dx 1 mm and 0.5 mm (17.4 / 18.9 N/m at 10 D, E 5 MPa) and the
+// shallow drag matches the default's within 4%. Pure APIC (0) adds a numerical viscosity that
+// doubles the deep drag.
+//
+// Stiffness: E = 50 MPa, ten times the other cases'. The paper gives no modulus for the media;
+// the model is meant to be rigid-plastic, so E must be stiff enough not to matter, and for this
+// case 5 MPa is not. Drag/F0 at 2.5, 5, 10, 15 D in the beds below (same dx, travel, window):
+// E 5 MPa 18.7, 44.3, 91.4, 129; 50 MPa 21.2, 47.4, 105, 201; 100 MPa 22.4, 48.4, 109, 209. Lift/F0
+// at 10 -> 15 D: 5 MPa levels off in these beds but not in the paper's (+42% there, with a ~1.5 mm
+// tunnel behind the cylinder filled from above and material sliding up its front face); 50 MPa
+// 18.9 -> 21.6 (+14%), paper bed 4.40 -> 4.75 N/m (+8%); 100 MPa 20.0 -> 24.8 (+24%). A soft bed
+// or a slow drag let a falling, stress-free column form above the wake (0.09 m bed, 10 -> 15 D:
+// E 1 MPa drag 13.7 -> 15.2 N/m; E 5 MPa at 0.03 m/s 14.4 -> 16.2 N/m), which caps the drag.
+// Cost: steps grow as sqrt(E) (3.2x from 5 to 50 MPa).
+constexpr double kD = 0.004, kCylDx = 0.001, kCylE = 5.0e7;
 const double kCylF0 = kPi * 0.25 * kD * kD * kRhoD * kG;  // pi (D/2)^2 rho_d g w
 
 // The cylinder starts `behind` from the left wall with `below` of bed under its centre and
 // `ahead` of bed beyond the end of its drag.
 Scene cylinder_scene(double depth_m, double behind_m, double below_m, double ahead_m, double travel_m) {
   Scene s = bed(behind_m + travel_m + ahead_m, depth_m + below_m, 0.01, kCylDx, 0.48);
+  s.materials[0].youngs_modulus_Pa = kCylE;
   s.solver.flip_blend = 0.9;
   s.solver.end_displacement_m = travel_m;
   s.bodies.push_back(circle_body("cylinder", kD, Vec2(behind_m, below_m), Vec2(0.1, 0.0)));
@@ -36,58 +48,51 @@ Scene cylinder_scene(double depth_m, double behind_m, double below_m, double ahe
 
 // Beds: for each depth z the smallest that does not change the drag much: 30 mm (7.5 D) of bed
 // under the centre (90 mm: the same drag at 15 D within 2%), 30 mm behind the start and
-// 1.5 z + 10 mm ahead of the end of the drag. At 15 D that gives 25.3 N/m against 26.2 N/m in the
-// paper's 0.2 m bed (42 mm ahead gave 20 N/m). The cylinder is dragged 8 mm (2 D); the first 3 mm
-// load the bed and are left out of the mean.
-// Measured when chosen: drag/F0 18.7, 44.3, 91.4, 129.0 at 2.5, 5, 10, 15 D: R^2 0.996.
-TEST(PaperCase1, CylinderDragGrowsLinearlyWithDepth) {
+// 1.5 z + 10 mm ahead of the end of the drag (measured with E 5 MPa: at 15 D 25.3 N/m against
+// 26.2 N/m in the paper's 0.2 m bed; 42 mm ahead gave 20 N/m; with E 50 MPa 37.5 N/m here, 39.3 N/m
+// in the paper bed over its 20 mm drag).
+// The cylinder is dragged 8 mm (2 D); the first 3 mm load the bed and are left out of the mean.
+// Measured when chosen: drag/F0 21.2, 47.4, 105.0, 201.2 at 2.5, 5, 10, 15 D: R^2 0.980 (the
+// deepest step is steeper than the rest); lift/F0 4.9, 8.1, 18.9, 21.6. 189 s on 2 cores.
+TEST(PaperCase1, CylinderDragGrowsLinearlyWhileLiftLevelsOff) {
   const double travel = 0.008, from = 0.003;
   const std::vector<double> depths_m = {0.010, 0.020, 0.040, 0.060};  // 2.5, 5, 10, 15 D
   std::vector<Scene> scenes;
   for (double z : depths_m) scenes.push_back(cylinder_scene(z, 0.03, 0.03, 1.5 * z + 0.01, travel));
   const std::vector<Trace> traces = run_all(scenes);
 
-  std::vector<double> zD, drag;
+  std::vector<double> zD, drag, lift;
   for (size_t i = 0; i < depths_m.size(); ++i) {
     zD.push_back(depths_m[i] / kD);
     drag.push_back(-window_mean(traces[i], 0, 0, from, travel) / kCylF0);
+    lift.push_back(window_mean(traces[i], 0, 1, from, travel) / kCylF0);
     std::printf("case 1: |z|/D %5.2f  drag/F0 %7.2f  lift/F0 %6.2f  (F0 %.4f N/m; %zu particles, %lld steps, %.1f s)\n",
-                zD.back(), drag.back(), window_mean(traces[i], 0, 1, from, travel) / kCylF0, kCylF0,
-                traces[i].particles, (long long)traces[i].steps, traces[i].wall_s);
+                zD.back(), drag.back(), lift.back(), kCylF0, traces[i].particles, (long long)traces[i].steps,
+                traces[i].wall_s);
   }
   const Fit f = fit_line(zD, drag);
-  std::printf("case 1: drag/F0 = %.3f + %.3f |z|/D, R^2 %.4f\n", f.intercept, f.slope, f.r2);
+  const size_t a = depths_m.size() - 2, b = a + 1;
+  const double drag_change = drag[b] / drag[a] - 1, lift_change = lift[b] / lift[a] - 1;
+  std::printf("case 1: drag/F0 = %.3f + %.3f |z|/D, R^2 %.4f; %g D -> %g D: drag %+.1f%%, lift %+.1f%%\n",
+              f.intercept, f.slope, f.r2, zD[a], zD[b], 100 * drag_change, 100 * lift_change);
   // resisting, growing with depth, and linear in it
   for (size_t i = 0; i < drag.size(); ++i) EXPECT_GT(drag[i], 0.0) << "|z|/D " << zD[i];
   EXPECT_GT(f.slope, 0.0);
   EXPECT_GE(f.r2, 0.97);
+  // the lift levels off: between the two deepest depths it changes by under a third as much
+  EXPECT_GT(lift[a], 0.0);
+  EXPECT_LT(std::abs(lift_change), drag_change / 3.0);
 }
 
-// The lift claim needs more than the drag: at 15 D the lift is still growing after 5 D of travel
-// and needs the paper's whole bed (in the drag test's smaller beds it changed by only +11% from
-// 10 D to 15 D: at 15 D those beds hold the lift 6..12% below the paper bed's). In the paper's 0.20 x 0.16 m bed,
-// cylinder from x = 0.05 m, dragged 20 mm, mean over 5..20 mm (`furrow sweep scenes/cylinder_drag.json
-// --vary bodies.cylinder.start_m.1=0.12,0.10 --set solver.end_displacement_m=0.02 --set
-// outputs.average_window.from_m=0.005 --set outputs.average_window.to_m=0.02`, 5.5 min on 2 cores):
-// drag 19.5 -> 30.2 N/m (+55%), lift 3.8 -> 5.4 N/m (+42%) from 10 D to 15 D. Lift stays 0.15..0.20
-// of the drag at every depth from 2.5 D to 15 D: it does not level off. What the flow shows at 15 D
-// (strain-rate and pressure frames): the cylinder leaves a ~1.5 mm open tunnel that closes only by
-// the roof falling under gravity (0.03 m/s), in a halo of open particles (phi 0.55..0.5995 < phi_d,
-// next to points at 0.6001 carrying 1..2 kPa), so the back of the cylinder sees little pressure.
-// Tried: taking each point's volume rate from the cell-centre divergence (filters the grid's
-// checkerboard): the lift then levels off (2.87 -> 2.92 N/m) but so does the drag (14.1 -> 14.9 N/m),
-// so it was not kept. At the paper's dx (D/8) in a 0.09 m wide bed with 0.04 m under the centre:
-// 10 D -> 15 D drag 18.4 -> 21.2 N/m (+16%), lift 4.95 -> 5.36 N/m (+8%), no better. The growing
-// part of the lift is body friction: same 0.09 m bed at dx = D/4, 10 D -> 15 D, mu_f 0.35: drag
-// 19.6 -> 28.4, lift 3.89 -> 5.27 N/m (+36%); mu_f 0: drag 17.3 -> 28.4, lift 3.00 -> 2.15 N/m
-// (-28%). Material slides up the front face more than down it (it refills the tunnel from above),
-// and mu_f times a pressure ~ z turns that into a lift ~ z. That run costs more than this suite's
-// budget, so it runs only with FURROW_LONG_PAPER_TESTS=1; otherwise the test is skipped.
-TEST(PaperCase1, CylinderLiftLevelsOffAtDepth) {
+// The same lift claim in the paper's whole 0.20 x 0.16 m bed, cylinder from x = 0.05 m, dragged
+// 20 mm, mean over 5..20 mm (`furrow sweep scenes/cylinder_drag.json --vary
+// bodies.cylinder.start_m.1=0.12,0.10 --set solver.end_displacement_m=0.02 --set
+// outputs.average_window.from_m=0.005 --set outputs.average_window.to_m=0.02`). Measured: 10 D -> 15 D drag 21.4 -> 39.3 N/m (+83%), lift
+// 4.40 -> 4.75 N/m (+8%); 22 min on 2 cores, so it runs only with FURROW_LONG_PAPER_TESTS=1.
+TEST(PaperCase1, CylinderLiftLevelsOffInPaperBed) {
   if (!std::getenv("FURROW_LONG_PAPER_TESTS"))
-    GTEST_SKIP() << "lift does not level off in this solver at dx = D/4 (paper bed, 20 mm of drag: from 10 D "
-                    "to 15 D drag +55%, lift +42%; the claim needs |lift change| < drag change / 3); the "
-                    "measurement takes 5.5 min on 2 cores: set FURROW_LONG_PAPER_TESTS=1 to run it";
+    GTEST_SKIP() << "the paper-bed check takes 22 min on 2 cores (measured: 10 D -> 15 D drag +83%, lift +8%); "
+                    "set FURROW_LONG_PAPER_TESTS=1 to run it";
   const double travel = 0.02, from = 0.005;
   const std::vector<double> depths_m = {0.040, 0.060};  // 10, 15 D
   std::vector<Scene> scenes;
