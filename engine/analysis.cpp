@@ -27,6 +27,67 @@ double dft_power(const std::vector<double>& x, const std::vector<double>* window
   return re * re + im * im;
 }
 
+// Samples in [lo, hi] box-averaged into whole bins of about `bin` travel (empty bins interpolated
+// between filled neighbours), then the least-squares line in travel removed.
+struct Binned {
+  int64_t samples = 0;
+  double bin_m = 0.0, mean = kNaN, slope = 0.0;
+  std::vector<double> residual;  // per bin, detrended; empty when no sample fell in the window
+};
+
+Binned bin_and_detrend(const std::vector<double>& travel_m, const std::vector<double>& value, double lo,
+                       double hi, double bin) {
+  Binned out;
+  const double len = hi - lo;
+  const int nb = std::max(1, int(std::floor(len / bin + 1e-9)));
+  out.bin_m = len / nb;  // whole bins spanning the window exactly
+  std::vector<double> sum(nb, 0.0);
+  std::vector<int> count(nb, 0);
+  for (size_t k = 0; k < travel_m.size(); ++k) {
+    const double s = travel_m[k];
+    if (!(s >= lo && s <= hi) || !std::isfinite(value[k])) continue;
+    const int b = std::min(nb - 1, int((s - lo) / out.bin_m));
+    sum[b] += value[k];
+    ++count[b];
+    ++out.samples;
+  }
+  std::vector<double> y(nb, kNaN);
+  std::vector<int> filled;
+  for (int b = 0; b < nb; ++b)
+    if (count[b]) {
+      y[b] = sum[b] / count[b];
+      filled.push_back(b);
+    }
+  if (filled.empty()) return out;
+  for (int b = 0; b < nb; ++b) {
+    if (count[b]) continue;
+    auto it = std::lower_bound(filled.begin(), filled.end(), b);
+    if (it == filled.begin()) y[b] = y[*it];
+    else if (it == filled.end()) y[b] = y[filled.back()];
+    else {
+      const int r = *it, l = *(it - 1);
+      y[b] = y[l] + (y[r] - y[l]) * double(b - l) / double(r - l);
+    }
+  }
+  double sx = 0, sy = 0;
+  for (int b = 0; b < nb; ++b) {
+    sx += (b + 0.5) * out.bin_m;
+    sy += y[b];
+  }
+  const double xm = sx / nb, ym = sy / nb;
+  double sxx = 0, sxy = 0;
+  for (int b = 0; b < nb; ++b) {
+    const double dxb = (b + 0.5) * out.bin_m - xm;
+    sxx += dxb * dxb;
+    sxy += dxb * (y[b] - ym);
+  }
+  out.mean = ym;
+  out.slope = sxx > 0.0 ? sxy / sxx : 0.0;
+  out.residual.resize(nb);
+  for (int b = 0; b < nb; ++b) out.residual[b] = y[b] - ym - out.slope * ((b + 0.5) * out.bin_m - xm);
+  return out;
+}
+
 }  // namespace
 
 DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector<double>& drag_N_per_m,
@@ -44,63 +105,19 @@ DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector
   st.to_m = hi;
   if (!(hi > lo)) return st;
   const double len = hi - lo;
-  const double bin = o.bin_m > 0.0 ? o.bin_m : len / 1024.0;
-  const int nb = std::max(1, int(std::floor(len / bin + 1e-9)));
-  st.bin_m = len / nb;  // whole bins spanning the window exactly
-  std::vector<double> sum(nb, 0.0);
-  std::vector<int> count(nb, 0);
-  for (size_t k = 0; k < travel_m.size(); ++k) {
-    const double s = travel_m[k];
-    if (!(s >= lo && s <= hi) || !std::isfinite(drag_N_per_m[k])) continue;
-    const int b = std::min(nb - 1, int((s - lo) / st.bin_m));
-    sum[b] += drag_N_per_m[k];
-    ++count[b];
-    ++st.samples;
-  }
-  // bin means; empty bins interpolated linearly between the nearest filled ones
-  std::vector<double> y(nb, kNaN);
-  std::vector<int> filled;
-  for (int b = 0; b < nb; ++b)
-    if (count[b]) {
-      y[b] = sum[b] / count[b];
-      filled.push_back(b);
-    }
+  const Binned bd = bin_and_detrend(travel_m, drag_N_per_m, lo, hi, o.bin_m > 0.0 ? o.bin_m : len / 1024.0);
+  st.bin_m = bd.bin_m;
+  st.samples = bd.samples;
+  const int nb = int(std::lround(len / bd.bin_m));
   st.bins = nb;
-  if (filled.empty()) return st;
-  for (int b = 0; b < nb; ++b) {
-    if (count[b]) continue;
-    auto it = std::lower_bound(filled.begin(), filled.end(), b);
-    if (it == filled.begin()) y[b] = y[*it];
-    else if (it == filled.end()) y[b] = y[filled.back()];
-    else {
-      const int r = *it, l = *(it - 1);
-      y[b] = y[l] + (y[r] - y[l]) * double(b - l) / double(r - l);
-    }
-  }
-
-  // mean and least-squares trend over bin centres
-  double sx = 0, sy = 0;
-  for (int b = 0; b < nb; ++b) {
-    sx += (b + 0.5) * st.bin_m;
-    sy += y[b];
-  }
-  const double xm = sx / nb, ym = sy / nb;
-  double sxx = 0, sxy = 0;
-  for (int b = 0; b < nb; ++b) {
-    const double dxb = (b + 0.5) * st.bin_m - xm;
-    sxx += dxb * dxb;
-    sxy += dxb * (y[b] - ym);
-  }
-  const double slope = sxx > 0.0 ? sxy / sxx : 0.0;
-  std::vector<double> r(nb);
+  if (bd.residual.empty()) return st;
+  const std::vector<double>& r = bd.residual;
   double ss = 0.0;
-  for (int b = 0; b < nb; ++b) {
-    r[b] = y[b] - ym - slope * ((b + 0.5) * st.bin_m - xm);
-    ss += r[b] * r[b];
-  }
+  for (double v : r) ss += v * v;
+  const double ym = bd.mean;
   st.mean_N_per_m = ym;
   if (nb < 3) return st;  // a line through two bins leaves nothing to measure
-  st.trend_N_per_m2 = slope;
+  st.trend_N_per_m2 = bd.slope;
   st.rms_N_per_m = std::sqrt(ss / nb);
   st.relative_fluctuation = ym != 0.0 ? st.rms_N_per_m / std::abs(ym) : kNaN;
 
@@ -143,6 +160,43 @@ DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector
   if (cycles < o.min_cycles) return st;
   st.period_m = len / cycles;
   return st;
+}
+
+ForceSmoothness force_smoothness(const std::vector<double>& s, const std::vector<double>& F, double cell_m,
+                                 double from_m, double to_m, double bin_m) {
+  if (s.size() != F.size()) throw std::invalid_argument("force_smoothness: travel and force have different lengths");
+  ForceSmoothness r;
+  r.mean_N_per_m = r.peak_ratio = r.peak_at_m = r.rms_relative = r.cell_amplitude_relative = kNaN;
+  std::vector<double> prefix(s.size() + 1, 0.0);
+  for (size_t k = 0; k < s.size(); ++k) prefix[k + 1] = prefix[k] + F[k];
+  double sum = 0.0, dev2 = 0.0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    if (!(s[k] >= from_m && s[k] <= to_m)) continue;
+    const size_t lo = size_t(std::lower_bound(s.begin(), s.end(), s[k] - 0.5 * cell_m) - s.begin());
+    const size_t hi = size_t(std::upper_bound(s.begin(), s.end(), s[k] + 0.5 * cell_m) - s.begin());
+    const double m = (prefix[hi] - prefix[lo]) / double(hi - lo);
+    if (!(F[k] / m <= r.peak_ratio)) {
+      r.peak_ratio = F[k] / m;
+      r.peak_at_m = s[k];
+    }
+    sum += F[k];
+    dev2 += (F[k] - m) * (F[k] - m);
+    ++r.samples;
+  }
+  if (r.samples == 0) return r;
+  r.mean_N_per_m = sum / double(r.samples);
+  r.rms_relative = std::sqrt(dev2 / double(r.samples)) / std::abs(r.mean_N_per_m);
+  // binned and detrended as drag_statistics does, then projected on the cell period
+  const Binned bd = bin_and_detrend(s, F, from_m, to_m, bin_m);
+  double c = 0.0, q = 0.0;
+  const size_t nb = bd.residual.size();
+  for (size_t b = 0; b < nb; ++b) {
+    const double phase = 2.0 * kPi * (from_m + (double(b) + 0.5) * bd.bin_m) / cell_m;
+    c += bd.residual[b] * std::cos(phase);
+    q += bd.residual[b] * std::sin(phase);
+  }
+  r.cell_amplitude_relative = 2.0 * std::hypot(c, q) / double(nb) / std::abs(bd.mean);
+  return r;
 }
 
 bool in_average_window(const Outputs& out, double t_s, double travel_m) {

@@ -90,6 +90,26 @@ struct DragStats {
 DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector<double>& drag_N_per_m,
                           const DragStatsOptions& options);
 
+// ---------------------------------------------------------------- grid artifacts in a force trace
+// How far a per-step force trace departs from its own average over one cell of travel: the
+// signature of contact that steps as a body face crosses node lines. Over samples with travel in
+// [from_m, to_m]:
+//   running mean M_k = mean of the samples within half a cell of travel of sample k;
+//   peak_ratio = max F_k / M_k; rms_relative = RMS(F_k - M_k) / mean F;
+//   cell_amplitude_relative = amplitude of the component of period `cell_m` (least-squares sine
+//   and cosine) in the force binned every `bin_m` of travel and detrended, over its mean.
+struct ForceSmoothness {
+  int64_t samples = 0;
+  double mean_N_per_m = 0.0;
+  double peak_ratio = 0.0;
+  double peak_at_m = 0.0;  // travel of the peak
+  double rms_relative = 0.0;
+  double cell_amplitude_relative = 0.0;
+};
+// travel_m non-decreasing; NaN fields when the window holds no sample.
+ForceSmoothness force_smoothness(const std::vector<double>& travel_m, const std::vector<double>& force_N_per_m,
+                                 double cell_m, double from_m, double to_m, double bin_m = 0.001);
+
 // Whether a step at time t_s with lead-body travel travel_m lies in the scene's averaging window
 // (outputs.average_window: by displacement when from_m >= 0, else by time; a negative "to" means
 // the end of the run).

@@ -192,8 +192,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
 
   if (frames_on) write_frame();
   const auto loop0 = clock::now();
+  int64_t contact_sweeps = 0, contact_unconverged = 0, contact_points_max = 0;
+  int contact_sweeps_max = 0;
   while (!sim.finished()) {
     sim.step();
+    const StepStats& st = sim.stats();
+    contact_sweeps += st.contact_sweeps;
+    contact_sweeps_max = std::max(contact_sweeps_max, st.contact_sweeps);
+    contact_points_max = std::max(contact_points_max, st.contact_points);
+    contact_unconverged += st.contact_converged ? 0 : 1;
     dt_min = std::min(dt_min, sim.last_dt_s());
     dt_max = std::max(dt_max, sim.last_dt_s());
     forces.add(sim);
@@ -239,6 +246,12 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
                            {"peak_force_N_per_m", vec_json(b.peak_N_per_m)},
                            {"window_steps", b.window_samples}});
   if (analysis.active()) j["analysis"] = analysis.to_json();
+  if (!scene.bodies.empty() && scene.solver.contact == ContactMethod::Particle)
+    j["contact"] = {{"method", "particle"},
+                    {"points_max", contact_points_max},
+                    {"sweeps_mean", sim.step_count() ? double(contact_sweeps) / double(sim.step_count()) : 0.0},
+                    {"sweeps_max", contact_sweeps_max},
+                    {"steps_not_converged", contact_unconverged}};
   write_file_atomic((tmp_dir / "run.json").string(), j.dump(2) + "\n");
 
   // move into place; an existing run (only with --force) is replaced after the new one is whole

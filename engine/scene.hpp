@@ -12,6 +12,10 @@ using Vec2 = Eigen::Vector2d;
 
 enum class ShapeFunction { Linear, Quadratic, Cubic };
 enum class MaterialModel { NDPM, DPM };
+// How bodies act on the media: on the grid nodes inside them (default; the force steps each time a
+// face crosses a node line), or on the material points touching their surface (smooth, but the
+// constraint spreads over the points' B-spline stencils: a body acts about a cell larger).
+enum class ContactMethod { Node, Particle };
 
 struct Material {
   std::string name = "sand";
@@ -97,6 +101,7 @@ struct Solver {
   // FLIP share of the particle velocity update (0 = pure APIC). APIC alone damps non-affine
   // motion once per step, a viscosity ~ dx^2/dt that grows as dt shrinks.
   double flip_blend = 0.99;
+  ContactMethod contact = ContactMethod::Node;
   double end_time_s = 1.0;
   double end_displacement_m = -1.0;  // stop when the first moving body has travelled this far (> 0)
   int threads = 0;                   // 0: all hardware threads

@@ -97,7 +97,7 @@ std::string one_of(const KeyList& names) {
 const KeyList kRootKeys = {"schema_version", "name", "description", "domain", "solver", "materials",
                            "beds", "bodies", "walls", "effects", "outputs"};
 const KeyList kDomainKeys = {"width_m", "height_m", "dx_m"};
-const KeyList kSolverKeys = {"shape_function", "particles_per_cell_1d", "cfl", "flip_blend", "end_time_s",
+const KeyList kSolverKeys = {"shape_function", "particles_per_cell_1d", "cfl", "flip_blend", "contact", "end_time_s",
                              "end_displacement_m", "threads", "max_steps"};
 const KeyList kMaterialNdpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_s",
                                    "youngs_modulus_Pa", "poisson_ratio"};
@@ -126,6 +126,7 @@ const KeyList kShapeTypes = {"circle", "box", "polygon", "union"};  // Shape::Ki
 const KeyList kMotionTypes = {"constant_velocity", "path"};
 const KeyList kWallTypes = {"slip", "friction", "sticky", "open"};
 const KeyList kShapeFunctions = {"linear", "quadratic", "cubic"};
+const KeyList kContactMethods = {"node", "particle"};  // ContactMethod order
 
 KeyList merged(std::initializer_list<const KeyList*> lists) {
   KeyList out;

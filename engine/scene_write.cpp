@@ -59,6 +59,7 @@ J to_json(const Scene& s) {
   solver["particles_per_cell_1d"] = s.solver.particles_per_cell_1d;
   solver["cfl"] = s.solver.cfl;
   solver["flip_blend"] = s.solver.flip_blend;
+  solver["contact"] = kContactMethods[size_t(s.solver.contact)];
   solver["end_time_s"] = s.solver.end_time_s;
   solver["end_displacement_m"] = s.solver.end_displacement_m > 0.0 ? J(s.solver.end_displacement_m) : J(nullptr);
   solver["threads"] = s.solver.threads;

@@ -59,6 +59,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   auto pick = [&](auto kernel) {
     using K = decltype(kernel);
     p2g_ = flip_ ? &Simulation::particles_to_grid<K, true> : &Simulation::particles_to_grid<K, false>;
+    contact_ = scene_.solver.contact == ContactMethod::Particle ? &Simulation::contact_particles<K>
+                                                                 : &Simulation::contact_nodes;
     g2p_ = flip_ ? &Simulation::grid_to_particles<K, true> : &Simulation::grid_to_particles<K, false>;
   };
   switch (scene_.solver.shape_function) {
@@ -320,6 +322,14 @@ inline bool contact(Vec2& v, const Vec2& vb, const Vec2& n, double mu) {
 }  // namespace
 
 void Simulation::bodies_and_walls() {
+  if (!bodies_.empty()) (this->*contact_)();
+  contact_walls();
+}
+
+// Node contact: every grid node inside a body takes the body's normal velocity (Coulomb slip
+// along it). The constrained set grows by a node row each time a face crosses a node line, so
+// the force steps with a period of one cell.
+void Simulation::contact_nodes() {
   const double dt = dt_s_, dx = g_.dx;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const Body& body = scene_.bodies[b];
@@ -345,8 +355,166 @@ void Simulation::bodies_and_walls() {
       }
     s.force_N_per_m = -impulse / dt;
   }
+}
 
-  // domain walls act on the nodes on and beyond each boundary line
+// Particle contact: the material points whose surface (centre + half their size) would reach a
+// body within this step are held to its normal velocity (Coulomb slip along it) by impulses
+// scattered onto the grid through their own weights, solved by Gauss-Seidel over the points.
+// The constraint follows the points, not the node lines, so the force moves smoothly as a face
+// crosses the grid, and it starts when the surfaces meet.
+template <class K>
+void Simulation::contact_particles() {
+  const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
+  const size_t n = p_.size(), nb = bodies_.size();
+  const auto& P = p_;
+  // candidates: points within one cell of a body's surface (no point moves a cell in a step);
+  // fixed chunks concatenated in order, so the list is the same for any thread count
+  constexpr size_t kChunks = 64;
+  const size_t chunk = (n + kChunks - 1) / kChunks;
+  contact_chunks_.resize(kChunks);
+  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
+    auto& out = contact_chunks_[c];
+    out.clear();
+    for (size_t p = c * chunk, end = std::min(n, p + chunk); p < end; ++p)
+      for (size_t b = 0; b < nb; ++b) {
+        const BodyState& s = bodies_[b];
+        const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
+        const double reach = 2.0 * dx;
+        if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
+            q.y() > s.hi_m.y() + reach)
+          continue;
+        out.push_back(uint32_t(p));
+        out.push_back(uint32_t(b));
+      }
+  });
+  std::vector<uint32_t> cand;
+  for (const auto& v : contact_chunks_) cand.insert(cand.end(), v.begin(), v.end());
+  const size_t nc = cand.size() / 2;
+  // the last step's impulses start the solve (warm start): a steady contact then needs few sweeps
+  std::vector<ContactPoint> previous;
+  previous.swap(contacts_);
+  contacts_.resize(nc);
+  std::vector<uint8_t> keep(nc, 0);
+  const bool friction = scene_.effects.body_friction;
+  tbb::parallel_for(size_t(0), nc, [&](size_t k) {
+    const uint32_t p = cand[2 * k], b = cand[2 * k + 1];
+    const BodyState& s = bodies_[b];
+    const Shape& shape = scene_.bodies[b].shape;
+    const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
+    const double half = 0.5 * std::sqrt(P.volume[p]);
+    const double gap = shape_sdf(shape, q) - half;
+    if (gap > dx) return;
+    ContactPoint& c = contacts_[k];
+    double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
+    const int bx = K::weights(P.x[p] * inv_dx, wx, dwx, inv_dx);
+    const int by = K::weights(P.y[p] * inv_dx, wy, dwy, inv_dx);
+    c.base = g_.index(bx, by);
+    // the impulse goes to the nodes in proportion to the point's weights (the least mass-weighted
+    // change of the node velocities that moves the point as required)
+    double sum = 0.0;
+    for (int j = 0; j < K::N; ++j)
+      for (int i = 0; i < K::N; ++i) {
+        const double w = wx[i] * wy[j];
+        c.w[j * K::N + i] = w;
+        const double m = g_.node[c.base + size_t(j) * g_.NX + i].m;
+        if (m > 0.0) sum += w * w / m;
+      }
+    c.inv_meff = sum;
+    c.n = shape_normal(shape, q, 1e-4 * dx);
+    c.vb = s.velocity_m_s;
+    c.gap_m = gap;
+    c.mu = friction ? scene_.bodies[b].friction : 0.0;
+    c.jn = c.jt = 0.0;
+    c.particle = p;
+    c.body = b;
+    keep[k] = sum > 0.0;
+  });
+  // a point near two bodies whose faces point the same way (under the joint of touching plates)
+  // is held by the nearer one only: two parallel constraints would split its impulse between the
+  // bodies by the order of the sweep
+  for (size_t k = 0; k + 1 < nc; ++k) {
+    if (!keep[k] || !keep[k + 1] || cand[2 * k] != cand[2 * k + 2]) continue;
+    const ContactPoint &a = contacts_[k], &b = contacts_[k + 1];
+    if (a.n.dot(b.n) > 0.5) keep[b.gap_m < a.gap_m ? k : k + 1] = 0;
+  }
+  size_t m = 0;
+  for (size_t k = 0; k < nc; ++k)
+    if (keep[k]) contacts_[m++] = contacts_[k];
+  contacts_.resize(m);
+
+  GridNode* grid = g_.node.data();
+  const size_t NX = size_t(g_.NX);
+  auto apply = [&](const ContactPoint& c, const Vec2& J) {
+    for (int j = 0; j < K::N; ++j)
+      for (int i = 0; i < K::N; ++i) {
+        GridNode& nd = grid[c.base + size_t(j) * NX + i];
+        if (nd.m <= 0.0) continue;
+        const double f = c.w[j * K::N + i] / nd.m;
+        nd.vx += f * J.x();
+        nd.vy += f * J.y();
+      }
+  };
+  // both lists are sorted by (particle, body)
+  for (size_t k = 0, o = 0; k < contacts_.size() && o < previous.size();) {
+    ContactPoint& c = contacts_[k];
+    const ContactPoint& q = previous[o];
+    if (q.particle < c.particle || (q.particle == c.particle && q.body < c.body)) {
+      ++o;
+    } else if (q.particle == c.particle && q.body == c.body) {
+      c.jn = q.jn;
+      c.jt = std::clamp(q.jt, -c.mu * c.jn, c.mu * c.jn);
+      apply(c, c.jn * c.n + c.jt * Vec2(-c.n.y(), c.n.x()));
+      ++k, ++o;
+    } else {
+      ++k;
+    }
+  }
+  double vscale = 1e-3;
+  for (const auto& s : bodies_) vscale = std::max(vscale, s.velocity_m_s.norm());
+  const double tol = 1e-5 * vscale;
+  constexpr int kMaxSweeps = 200;
+  int sweep = 0;
+  double residual = 0.0;
+  for (; sweep < kMaxSweeps; ++sweep) {
+    residual = 0.0;
+    for (ContactPoint& c : contacts_) {
+      double vx = 0.0, vy = 0.0;
+      for (int j = 0; j < K::N; ++j)
+        for (int i = 0; i < K::N; ++i) {
+          const GridNode& nd = grid[c.base + size_t(j) * NX + i];
+          const double w = c.w[j * K::N + i];
+          vx += w * nd.vx;
+          vy += w * nd.vy;
+        }
+      const Vec2 rel = Vec2(vx, vy) - c.vb, t(-c.n.y(), c.n.x());
+      const double meff = 1.0 / c.inv_meff;
+      // normal: approach no faster than closes the gap in this step; impulses only push
+      const double vn = rel.dot(c.n), target = -std::max(c.gap_m, 0.0) / dt;
+      const double jn = std::max(0.0, c.jn + meff * (target - vn));
+      // tangential: stop the slip, within the Coulomb cone of the normal impulse
+      const double jt = std::clamp(c.jt - meff * rel.dot(t), -c.mu * jn, c.mu * jn);
+      const Vec2 J = (jn - c.jn) * c.n + (jt - c.jt) * t;
+      c.jn = jn;
+      c.jt = jt;
+      if (J.x() == 0.0 && J.y() == 0.0) continue;
+      residual = std::max(residual, J.norm() * c.inv_meff);
+      apply(c, J);
+    }
+    if (residual <= tol) break;
+  }
+  std::vector<Vec2> impulse(nb, Vec2(0.0, 0.0));
+  for (const ContactPoint& c : contacts_) impulse[c.body] += c.jn * c.n + c.jt * Vec2(-c.n.y(), c.n.x());
+  for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m = -impulse[b] / dt;
+  stats_.contact_points = int64_t(contacts_.size());
+  stats_.contact_sweeps = std::min(sweep + 1, kMaxSweeps);
+  stats_.contact_residual_m_s = residual;
+  stats_.contact_converged = residual <= tol;
+}
+
+// Domain walls act on the nodes on and beyond each boundary line (walls lie on node lines, so
+// node contact is exact for them).
+void Simulation::contact_walls() {
+  const double dt = dt_s_;
   const bool wall_friction = scene_.effects.wall_friction;
   auto wall = [&](const Wall& w, int side, int i0, int i1, int j0, int j1, Vec2 n) {
     Vec2 impulse(0.0, 0.0);
@@ -523,6 +691,14 @@ void Simulation::reorder_particles() {
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
   for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);
+  // the contact list (kept for the next step's warm start) follows its particles
+  if (!contacts_.empty()) {
+    for (size_t i = 0; i < n; ++i) key[perm[i]] = uint32_t(i);
+    for (auto& c : contacts_) c.particle = key[c.particle];
+    std::sort(contacts_.begin(), contacts_.end(), [](const ContactPoint& a, const ContactPoint& b) {
+      return a.particle != b.particle ? a.particle < b.particle : a.body < b.body;
+    });
+  }
   auto permute = [&](auto& a) {
     if (a.empty()) return;
     std::remove_reference_t<decltype(a)> tmp(a.size());

@@ -57,6 +57,23 @@ struct BodyState {
 struct StepStats {
   int64_t projected_particles = 0;  // particles pushed out of bodies by the safety projection
   double max_speed_m_s = 0.0;
+  int64_t contact_points = 0;       // material points in contact with a body (particle contact)
+  int contact_sweeps = 0;           // Gauss-Seidel sweeps the contact solve took
+  double contact_residual_m_s = 0.0;  // largest velocity correction in the last sweep
+  bool contact_converged = true;      // the solve met its tolerance within its sweep limit
+};
+
+// A material point near a body's surface and its contact impulses (particle contact).
+struct ContactPoint {
+  size_t base;            // grid index of the first node of the point's stencil
+  double w[16];           // stencil weights, row-major (Kernel::N^2 used)
+  Vec2 n;                 // body's outward normal at the point
+  Vec2 vb;                // body velocity
+  double gap_m;           // surface-to-surface distance (negative: overlap)
+  double inv_meff;        // velocity response of the point to a unit impulse there (1/kg)
+  double mu;              // Coulomb friction
+  double jn = 0, jt = 0;  // accumulated normal and tangential impulses (N s per metre)
+  uint32_t particle, body;
 };
 
 class Simulation {
@@ -101,6 +118,9 @@ class Simulation {
   template <class Kernel, bool Flip> void particles_to_grid();
   void grid_update();
   void bodies_and_walls();
+  template <class Kernel> void contact_particles();
+  void contact_nodes();
+  void contact_walls();
   template <class Kernel, bool Flip> void grid_to_particles();
   template <bool Dilatancy, bool Track> void constitutive_update();
   void advance_bodies();
@@ -127,6 +147,9 @@ class Simulation {
   void (Simulation::*p2g_)() = nullptr;
   void (Simulation::*g2p_)() = nullptr;
   void (Simulation::*constitutive_)() = nullptr;
+  void (Simulation::*contact_)() = nullptr;
+  std::vector<ContactPoint> contacts_;
+  std::vector<std::vector<uint32_t>> contact_chunks_;
   std::unique_ptr<tbb::task_arena> arena_;
 };
 

@@ -288,6 +288,8 @@ std::vector<BadCase> bad_cases() {
       {"bodies not an array", with(P, [](json& j) { j["bodies"] = json::object(); }), {}, "/bodies", "array"},
       {"unknown top-level key", with(P, [](json& j) { j["domian"] = 1; }), {}, "/domian", "did you mean \"domain\""},
       {"unknown solver key", with(P, [](json& j) { j["solver"]["cfl_number"] = 0.3; }), {}, "/solver/cfl_number", "keys here"},
+      {"unknown contact method", with(P, [](json& j) { j["solver"]["contact"] = "penalty"; }), {}, "/solver/contact", "\"particle\""},
+      {"contact method not a string", plain(P), {"solver.contact=2"}, "/solver/contact", "\"node\""},
       {"unknown shape key", with(P, [](json& j) { j["bodies"][0]["shape"]["sizem"] = 1; }), {}, "/bodies/0/shape/sizem", "did you mean \"size_m\""},
       {"unknown knot key", with(P, [](json& j) {
          j["bodies"][0]["motion"] = json::parse(R"({"type": "path", "knots": [{"t_s": 0, "velocity": [0, -0.1]}]})");
