@@ -194,6 +194,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   const auto loop0 = clock::now();
   int64_t contact_sweeps = 0, contact_unconverged = 0, contact_points_max = 0;
   int contact_sweeps_max = 0;
+  double contact_residual_max = 0.0;
   while (!sim.finished()) {
     sim.step();
     const StepStats& st = sim.stats();
@@ -201,6 +202,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     contact_sweeps_max = std::max(contact_sweeps_max, st.contact_sweeps);
     contact_points_max = std::max(contact_points_max, st.contact_points);
     contact_unconverged += st.contact_converged ? 0 : 1;
+    contact_residual_max = std::max(contact_residual_max, st.contact_residual_m_s);
     dt_min = std::min(dt_min, sim.last_dt_s());
     dt_max = std::max(dt_max, sim.last_dt_s());
     forces.add(sim);
@@ -251,7 +253,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
                     {"points_max", contact_points_max},
                     {"sweeps_mean", sim.step_count() ? double(contact_sweeps) / double(sim.step_count()) : 0.0},
                     {"sweeps_max", contact_sweeps_max},
-                    {"steps_not_converged", contact_unconverged}};
+                    {"steps_not_converged", contact_unconverged},
+                    {"last_sweep_change_max_m_s", contact_residual_max}};
   write_file_atomic((tmp_dir / "run.json").string(), j.dump(2) + "\n");
 
   // move into place; an existing run (only with --force) is replaced after the new one is whole

@@ -365,31 +365,46 @@ void Simulation::contact_nodes() {
 template <class K>
 void Simulation::contact_particles() {
   const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
-  const size_t n = p_.size(), nb = bodies_.size();
+  const size_t nb = bodies_.size();
   const auto& P = p_;
-  // candidates: points within one cell of a body's surface (no point moves a cell in a step);
-  // fixed chunks concatenated in order, so the list is the same for any thread count
-  constexpr size_t kChunks = 64;
-  const size_t chunk = (n + kChunks - 1) / kChunks;
-  contact_chunks_.resize(kChunks);
-  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
-    auto& out = contact_chunks_[c];
+  // candidates: points within two cells of a body's box (no point moves a cell in a step), found
+  // in the strips of sort_particles() that the box spans, then put in (particle, body) order so
+  // the list is the same for any thread count
+  const double reach = 2.0 * dx;
+  const int strips = int(strip_start_.size()) - 1;
+  contact_chunks_.resize(size_t(strips) * nb);
+  std::vector<std::pair<int, int>> spans(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    const BodyState& s = bodies_[b];
+    auto strip_of = [&](double x) { return std::clamp(int(std::floor(x * inv_dx)) / kStripCells + 1, 0, strips - 1); };
+    spans[b] = {strip_of(s.position_m.x() + s.lo_m.x() - reach), strip_of(s.position_m.x() + s.hi_m.x() + reach)};
+  }
+  tbb::parallel_for(size_t(0), contact_chunks_.size(), [&](size_t k) {
+    const size_t b = k / size_t(strips);
+    const int strip = int(k % size_t(strips));
+    auto& out = contact_chunks_[k];
     out.clear();
-    for (size_t p = c * chunk, end = std::min(n, p + chunk); p < end; ++p)
-      for (size_t b = 0; b < nb; ++b) {
-        const BodyState& s = bodies_[b];
-        const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
-        const double reach = 2.0 * dx;
-        if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
-            q.y() > s.hi_m.y() + reach)
-          continue;
-        out.push_back(uint32_t(p));
-        out.push_back(uint32_t(b));
-      }
+    if (strip < spans[b].first || strip > spans[b].second) return;
+    const BodyState& s = bodies_[b];
+    for (uint32_t i = strip_start_[strip]; i < strip_start_[strip + 1]; ++i) {
+      const uint32_t p = order_[i];
+      const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
+      if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
+          q.y() > s.hi_m.y() + reach)
+        continue;
+      out.push_back(p);
+    }
   });
-  std::vector<uint32_t> cand;
-  for (const auto& v : contact_chunks_) cand.insert(cand.end(), v.begin(), v.end());
-  const size_t nc = cand.size() / 2;
+  std::vector<uint64_t> keys;
+  for (size_t k = 0; k < contact_chunks_.size(); ++k)
+    for (uint32_t p : contact_chunks_[k]) keys.push_back(uint64_t(p) << 32 | uint64_t(k / size_t(strips)));
+  std::sort(keys.begin(), keys.end());
+  std::vector<uint32_t> cand(2 * keys.size());
+  for (size_t k = 0; k < keys.size(); ++k) {
+    cand[2 * k] = uint32_t(keys[k] >> 32);
+    cand[2 * k + 1] = uint32_t(keys[k] & 0xffffffffu);
+  }
+  const size_t nc = keys.size();
   // the last step's impulses start the solve (warm start): a steady contact then needs few sweeps
   std::vector<ContactPoint> previous;
   previous.swap(contacts_);
@@ -475,9 +490,13 @@ void Simulation::contact_particles() {
   constexpr int kMaxSweeps = 200;
   int sweep = 0;
   double residual = 0.0;
+  // sweeps alternate direction (symmetric Gauss-Seidel): a point's neighbours on both sides
+  // answer within one pair of sweeps, and the unconverged remainder favours neither end
+  const size_t npts = contacts_.size();
   for (; sweep < kMaxSweeps; ++sweep) {
     residual = 0.0;
-    for (ContactPoint& c : contacts_) {
+    for (size_t k = 0; k < npts; ++k) {
+      ContactPoint& c = contacts_[sweep % 2 ? npts - 1 - k : k];
       double vx = 0.0, vy = 0.0;
       for (int j = 0; j < K::N; ++j)
         for (int i = 0; i < K::N; ++i) {
