@@ -490,13 +490,9 @@ void Simulation::contact_particles() {
   constexpr int kMaxSweeps = 200;
   int sweep = 0;
   double residual = 0.0;
-  // sweeps alternate direction (symmetric Gauss-Seidel): a point's neighbours on both sides
-  // answer within one pair of sweeps, and the unconverged remainder favours neither end
-  const size_t npts = contacts_.size();
   for (; sweep < kMaxSweeps; ++sweep) {
     residual = 0.0;
-    for (size_t k = 0; k < npts; ++k) {
-      ContactPoint& c = contacts_[sweep % 2 ? npts - 1 - k : k];
+    for (ContactPoint& c : contacts_) {
       double vx = 0.0, vy = 0.0;
       for (int j = 0; j < K::N; ++j)
         for (int i = 0; i < K::N; ++i) {
