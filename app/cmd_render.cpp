@@ -11,6 +11,7 @@
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"
 #include "render/image_io.hpp"
+#include "render/plot.hpp"
 #include "render/test_scene.hpp"
 
 namespace fs = std::filesystem;
@@ -197,6 +198,70 @@ int render_main(const Parsed& p) {
   return 0;
 }
 
+// Overlays one body's force-vs-displacement trace from several runs (e.g. two contact methods or
+// two resolutions of one scene) in one chart.
+int compare_main(const Parsed& p) {
+  std::vector<std::string> labels;
+  if (p.has("--labels")) {
+    const std::string l = p.get("--labels");
+    size_t start = 0;
+    for (size_t c = l.find(','); ; c = l.find(',', start)) {
+      labels.push_back(l.substr(start, c == std::string::npos ? std::string::npos : c - start));
+      if (c == std::string::npos) break;
+      start = c + 1;
+    }
+    if (labels.size() != p.positional.size())
+      throw UsageError("--labels: " + std::to_string(labels.size()) + " labels for " +
+                       std::to_string(p.positional.size()) + " runs");
+  }
+  const std::string body = p.get("--body");
+  const double lo = p.has("--from") ? parse_number(p.get("--from"), "--from") : -INFINITY;
+  const double hi = p.has("--to") ? parse_number(p.get("--to"), "--to") : INFINITY;
+  if (!(hi > lo)) throw UsageError("--to must be above --from");
+  render::PlotPanel panel;
+  panel.x_label = "displacement (mm)";
+  panel.y_label = "resisting force (N/m)";
+  for (size_t r = 0; r < p.positional.size(); ++r) {
+    const fs::path forces = fs::path(p.positional[r]) / "forces.csv";
+    if (!fs::exists(forces)) {
+      std::cerr << "furrow compare: " << forces.string() << " does not exist (is " << p.positional[r]
+                << " a run directory from 'furrow run'?)\n";
+      return 1;
+    }
+    const render::ForcePanel f = render::read_force_panel(forces.string());
+    const render::ForceSeries* s = nullptr;
+    for (const auto& c : f.series)
+      if (body.empty() || c.label == body) {
+        s = &c;
+        break;
+      }
+    if (!s) {
+      std::string have;
+      for (const auto& c : f.series) have += (have.empty() ? "" : ", ") + c.label;
+      std::cerr << "furrow compare: " << forces.string() << " has no body '" << body << "' (bodies: " << have << ")\n";
+      return 1;
+    }
+    render::PlotSeries ps;
+    ps.label = labels.empty() ? fs::path(p.positional[r]).filename().string() + " (" + s->label + ")" : labels[r];
+    ps.markers = false;
+    for (size_t k = 0; k < s->x.size(); ++k)
+      if (s->x[k] >= lo && s->x[k] <= hi) {
+        ps.x.push_back(s->x[k]);
+        ps.y.push_back(s->y[k]);
+      }
+    panel.series.push_back(ps);
+  }
+  render::PlotFigure fig;
+  fig.title = p.get("--title");
+  fig.panels.push_back(panel);
+  if (p.has("--size")) parse_size(p.get("--size"), &fig.width, &fig.height);
+  bool overwrite = false;
+  const std::string out = choose_output(p, fs::path("force_comparison.png"), &overwrite);
+  render::write_figure_png(fig, out, overwrite);
+  std::cout << out << "\n";
+  return 0;
+}
+
 int demo_main(const Parsed& p) {
   const fs::path dir = fs::path(p.get("--out", "out")) / "demo";
   fs::create_directories(dir);
@@ -246,6 +311,29 @@ Command command_render() {
           1,
           1,
           render_main};
+}
+
+Command command_compare() {
+  return {"compare",
+          "overlay the force traces of several runs in one chart (PNG)",
+          "furrow compare RUN_DIR RUN_DIR... [--body NAME] [--from MM] [--to MM] [--labels a,b,...] [--out FILE.png]",
+          "Reads RUN_DIR/forces.csv of each run and draws one body's resisting force -F.d (N/m, d the\n"
+          "unit direction of its travel) against its displacement (mm), all runs in one chart: two\n"
+          "contact methods, two resolutions or two materials of one scene side by side. The body is\n"
+          "the first one in each file unless --body names it. Writes force_comparison.png in the\n"
+          "current folder (or the next free name) unless --out is given; a taken --out is an error\n"
+          "unless --overwrite. Prints the path written.",
+          {{"--body", true, false, "body name (default: the first body of each run)", "NAME"},
+           {"--from", true, false, "first displacement to draw (mm)", "MM"},
+           {"--to", true, false, "last displacement to draw (mm)", "MM"},
+           {"--labels", true, false, "legend entries, one per run, comma-separated (default: folder names)", "LIST"},
+           {"--title", true, false, "chart title", "TEXT"},
+           {"--size", true, false, "image size (default 1280x720)", "WxH"},
+           {"--out", true, false, "output PNG", "FILE"},
+           {"--overwrite", false, false, "replace an existing output"}},
+          1,
+          16,
+          compare_main};
 }
 
 Command command_demo() {

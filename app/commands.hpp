@@ -10,6 +10,7 @@ Command command_new();        // app/cmd_scene.cpp
 Command command_templates();  // app/cmd_scene.cpp
 Command command_render();     // app/cmd_render.cpp
 Command command_demo();       // app/cmd_render.cpp
+Command command_compare();    // app/cmd_render.cpp
 Command command_sweep();      // app/cmd_sweep.cpp
 
 // Shared by run and sweep (app/cmd_run.cpp): the scene from PATH with --set/--threads/--yes
