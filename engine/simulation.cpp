@@ -364,7 +364,15 @@ void Simulation::contact_nodes() {
 // crosses the grid, and it starts when the surfaces meet.
 template <class K>
 void Simulation::contact_particles() {
-  const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
+  find_contact_points<K>();
+  solve_contact_points<K>();
+}
+
+// The points in (or about to be in) contact, with their stencils, normals and gaps; impulses
+// start from the last step's (warm start).
+template <class K>
+void Simulation::find_contact_points() {
+  const double dx = g_.dx, inv_dx = 1.0 / dx;
   const size_t nb = bodies_.size();
   const auto& P = p_;
   // candidates: points within two cells of a body's box (no point moves a cell in a step), found
@@ -456,19 +464,6 @@ void Simulation::contact_particles() {
   for (size_t k = 0; k < nc; ++k)
     if (keep[k]) contacts_[m++] = contacts_[k];
   contacts_.resize(m);
-
-  GridNode* grid = g_.node.data();
-  const size_t NX = size_t(g_.NX);
-  auto apply = [&](const ContactPoint& c, const Vec2& J) {
-    for (int j = 0; j < K::N; ++j)
-      for (int i = 0; i < K::N; ++i) {
-        GridNode& nd = grid[c.base + size_t(j) * NX + i];
-        if (nd.m <= 0.0) continue;
-        const double f = c.w[j * K::N + i] / nd.m;
-        nd.vx += f * J.x();
-        nd.vy += f * J.y();
-      }
-  };
   // both lists are sorted by (particle, body)
   for (size_t k = 0, o = 0; k < contacts_.size() && o < previous.size();) {
     ContactPoint& c = contacts_[k];
@@ -478,12 +473,36 @@ void Simulation::contact_particles() {
     } else if (q.particle == c.particle && q.body == c.body) {
       c.jn = q.jn;
       c.jt = std::clamp(q.jt, -c.mu * c.jn, c.mu * c.jn);
-      apply(c, c.jn * c.n + c.jt * Vec2(-c.n.y(), c.n.x()));
+      apply_contact_impulse<K>(c, c.jn * c.n + c.jt * Vec2(-c.n.y(), c.n.x()));
       ++k, ++o;
     } else {
       ++k;
     }
   }
+}
+
+// Adds impulse J (N s per metre) at point c to the node velocities, shared by its weights.
+template <class K>
+void Simulation::apply_contact_impulse(const ContactPoint& c, const Vec2& J) {
+  GridNode* grid = g_.node.data();
+  for (int j = 0; j < K::N; ++j)
+    for (int i = 0; i < K::N; ++i) {
+      GridNode& nd = grid[c.base + size_t(j) * size_t(g_.NX) + i];
+      if (nd.m <= 0.0) continue;
+      const double f = c.w[j * K::N + i] / nd.m;
+      nd.vx += f * J.x();
+      nd.vy += f * J.y();
+    }
+}
+
+// Gauss-Seidel over the points until the largest velocity change of a sweep is below 1e-5 of the
+// bodies' speed; the bodies' forces are minus the impulses they gave.
+template <class K>
+void Simulation::solve_contact_points() {
+  const double dt = dt_s_;
+  const size_t nb = bodies_.size();
+  const GridNode* grid = g_.node.data();
+  const size_t NX = size_t(g_.NX);
   double vscale = 1e-3;
   for (const auto& s : bodies_) vscale = std::max(vscale, s.velocity_m_s.norm());
   const double tol = 1e-5 * vscale;
@@ -513,7 +532,7 @@ void Simulation::contact_particles() {
       c.jt = jt;
       if (J.x() == 0.0 && J.y() == 0.0) continue;
       residual = std::max(residual, J.norm() * c.inv_meff);
-      apply(c, J);
+      apply_contact_impulse<K>(c, J);
     }
     if (residual <= tol) break;
   }

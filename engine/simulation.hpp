@@ -119,6 +119,9 @@ class Simulation {
   void grid_update();
   void bodies_and_walls();
   template <class Kernel> void contact_particles();
+  template <class Kernel> void find_contact_points();
+  template <class Kernel> void solve_contact_points();
+  template <class Kernel> void apply_contact_impulse(const ContactPoint& c, const Vec2& J);
   void contact_nodes();
   void contact_walls();
   template <class Kernel, bool Flip> void grid_to_particles();
