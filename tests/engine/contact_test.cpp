@@ -63,10 +63,10 @@ TEST(ContactSmoothness, PlateIntrusionForceHasNoCellComb) {
 // loose_intrusion (dx 2.5 mm, plate 2 mm above the bed at the start). The first cells of
 // penetration are the impact on loose, stress-free material (particle rows struck one by one:
 // peak 1.42x the one-cell mean at 2.9 mm depth, 1.2x at 5 mm; node contact 7.8x); from three
-// cells on no step rises above 1.2x its one-cell mean (measured 1.07x; node contact 3.8x at
-// 10 mm depth, 2.2x late).
+// cells on no step rises above 1.2x its one-cell mean (measured 1.07x over the whole run; node
+// contact 3.8x at 10 mm depth, 2.2x late). The test stops at 35 mm of travel to save time.
 TEST(ContactSmoothness, LooseIntrusionHasNoSpikes) {
-  const Trace t = run_template("loose_intrusion", 0.0, ContactMethod::Particle);
+  const Trace t = run_template("loose_intrusion", 0.035, ContactMethod::Particle);  // 33 of its 60 mm
   const double gap = 0.002, dx = t.dx_m;
   const ForceSmoothness f = force_smoothness(t.travel_m, t.drag_N_per_m, dx, gap + 3 * dx, t.travel_m.back() - 0.5 * dx);
   report("loose_intrusion", f);
