@@ -45,6 +45,18 @@ void parse_size(const std::string& s, int* w, int* h) {
   *w = int(ww), *h = int(hh);
 }
 
+// "a,b,,c" -> {"a", "b", "", "c"}: every field, empty ones too
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t c = s.find(sep); ; c = s.find(sep, start)) {
+    parts.push_back(s.substr(start, c == std::string::npos ? std::string::npos : c - start));
+    if (c == std::string::npos) break;
+    start = c + 1;
+  }
+  return parts;
+}
+
 long long frame_number(const std::string& path) {
   const std::string stem = fs::path(path).stem().string();  // frame_00042
   return std::stoll(stem.substr(stem.find('_') + 1));
@@ -54,13 +66,7 @@ long long frame_number(const std::string& path) {
 // "a" alone is one frame.
 std::vector<std::string> select_frames(const std::vector<std::string>& all, const std::string& spec) {
   if (spec.empty()) return all;
-  std::vector<std::string> parts;
-  size_t start = 0;
-  for (size_t c = spec.find(':'); ; c = spec.find(':', start)) {
-    parts.push_back(spec.substr(start, c == std::string::npos ? std::string::npos : c - start));
-    if (c == std::string::npos) break;
-    start = c + 1;
-  }
+  const std::vector<std::string> parts = split(spec, ':');
   if (parts.size() > 3) throw UsageError("--frames: expected a:b[:step], got '" + spec + "'");
   long long a = parts[0].empty() ? LLONG_MIN : parse_int(parts[0], "--frames");
   long long b = parts.size() == 1 ? a : (parts[1].empty() ? LLONG_MAX : parse_int(parts[1], "--frames"));
@@ -203,13 +209,7 @@ int render_main(const Parsed& p) {
 int compare_main(const Parsed& p) {
   std::vector<std::string> labels;
   if (p.has("--labels")) {
-    const std::string l = p.get("--labels");
-    size_t start = 0;
-    for (size_t c = l.find(','); ; c = l.find(',', start)) {
-      labels.push_back(l.substr(start, c == std::string::npos ? std::string::npos : c - start));
-      if (c == std::string::npos) break;
-      start = c + 1;
-    }
+    labels = split(p.get("--labels"), ',');
     if (labels.size() != p.positional.size())
       throw UsageError("--labels: " + std::to_string(labels.size()) + " labels for " +
                        std::to_string(p.positional.size()) + " runs");
