@@ -21,6 +21,11 @@ namespace {
 
 constexpr size_t kGrain = 4096;  // particles per TBB task
 
+// The P2G strip of `cells` cell columns holding x; strip 0 and the last take the grid margins.
+inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
+  return std::clamp(int(std::floor(x_m * inv_dx)) / cells + 1, 0, strips - 1);
+}
+
 }  // namespace
 
 Simulation::Simulation(const Scene& scene) : scene_(scene) {
@@ -191,7 +196,7 @@ void Simulation::sort_particles() {
   tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
     uint32_t* count = &chunk_counts_[c * size_t(strips)];
     for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) {
-      const int s = std::clamp(int(std::floor(p_.x[i] * inv)) / kStripCells + 1, 0, strips - 1);
+      const int s = strip_index(p_.x[i], inv, kStripCells, strips);
       scratch_u32_[i] = uint32_t(s);
       ++count[s];
     }
@@ -384,8 +389,8 @@ void Simulation::find_contact_points() {
   std::vector<std::pair<int, int>> spans(nb);
   for (size_t b = 0; b < nb; ++b) {
     const BodyState& s = bodies_[b];
-    auto strip_of = [&](double x) { return std::clamp(int(std::floor(x * inv_dx)) / kStripCells + 1, 0, strips - 1); };
-    spans[b] = {strip_of(s.position_m.x() + s.lo_m.x() - reach), strip_of(s.position_m.x() + s.hi_m.x() + reach)};
+    spans[b] = {strip_index(s.position_m.x() + s.lo_m.x() - reach, inv_dx, kStripCells, strips),
+                strip_index(s.position_m.x() + s.hi_m.x() + reach, inv_dx, kStripCells, strips)};
   }
   tbb::parallel_for(size_t(0), contact_chunks_.size(), [&](size_t k) {
     const size_t b = k / size_t(strips);
