@@ -31,6 +31,7 @@ double dft_power(const std::vector<double>& x, const std::vector<double>* window
 // between filled neighbours), then the least-squares line in travel removed.
 struct Binned {
   int64_t samples = 0;
+  int bins = 0;
   double bin_m = 0.0, mean = kNaN, slope = 0.0;
   std::vector<double> residual;  // per bin, detrended; empty when no sample fell in the window
 };
@@ -40,6 +41,7 @@ Binned bin_and_detrend(const std::vector<double>& travel_m, const std::vector<do
   Binned out;
   const double len = hi - lo;
   const int nb = std::max(1, int(std::floor(len / bin + 1e-9)));
+  out.bins = nb;
   out.bin_m = len / nb;  // whole bins spanning the window exactly
   std::vector<double> sum(nb, 0.0);
   std::vector<int> count(nb, 0);
@@ -108,7 +110,7 @@ DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector
   const Binned bd = bin_and_detrend(travel_m, drag_N_per_m, lo, hi, o.bin_m > 0.0 ? o.bin_m : len / 1024.0);
   st.bin_m = bd.bin_m;
   st.samples = bd.samples;
-  const int nb = int(std::lround(len / bd.bin_m));
+  const int nb = bd.bins;
   st.bins = nb;
   if (bd.residual.empty()) return st;
   const std::vector<double>& r = bd.residual;

@@ -478,7 +478,7 @@ void Simulation::find_contact_points() {
     } else if (q.particle == c.particle && q.body == c.body) {
       c.jn = q.jn;
       c.jt = std::clamp(q.jt, -c.mu * c.jn, c.mu * c.jn);
-      apply_contact_impulse<K>(c, c.jn * c.n + c.jt * Vec2(-c.n.y(), c.n.x()));
+      apply_contact_impulse<K>(c, c.impulse());
       ++k, ++o;
     } else {
       ++k;
@@ -525,7 +525,7 @@ void Simulation::solve_contact_points() {
           vx += w * nd.vx;
           vy += w * nd.vy;
         }
-      const Vec2 rel = Vec2(vx, vy) - c.vb, t(-c.n.y(), c.n.x());
+      const Vec2 rel = Vec2(vx, vy) - c.vb, t = c.tangent();
       const double meff = 1.0 / c.inv_meff;
       // normal: approach no faster than closes the gap in this step; impulses only push
       const double vn = rel.dot(c.n), target = -std::max(c.gap_m, 0.0) / dt;
@@ -542,7 +542,7 @@ void Simulation::solve_contact_points() {
     if (residual <= tol) break;
   }
   std::vector<Vec2> impulse(nb, Vec2(0.0, 0.0));
-  for (const ContactPoint& c : contacts_) impulse[c.body] += c.jn * c.n + c.jt * Vec2(-c.n.y(), c.n.x());
+  for (const ContactPoint& c : contacts_) impulse[c.body] += c.impulse();
   for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m = -impulse[b] / dt;
   stats_.contact_points = int64_t(contacts_.size());
   stats_.contact_sweeps = std::min(sweep + 1, kMaxSweeps);

@@ -74,6 +74,8 @@ struct ContactPoint {
   double mu;              // Coulomb friction
   double jn = 0, jt = 0;  // accumulated normal and tangential impulses (N s per metre)
   uint32_t particle, body;
+  Vec2 tangent() const { return Vec2(-n.y(), n.x()); }
+  Vec2 impulse() const { return jn * n + jt * tangent(); }
 };
 
 class Simulation {
