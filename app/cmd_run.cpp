@@ -24,6 +24,33 @@ Scene load_scene_for_cli(const Parsed& p, const std::string& path) {
   return load_scene(path, sets, v);
 }
 
+Scene load_varied_scene(const Parsed& p, const std::string& path, const std::vector<sweep::Vary>& varies,
+                        const std::vector<size_t>& combo, const std::string& option) {
+  Parsed q = p;
+  for (const auto& s : sweep::run_overrides(varies, combo)) q.values["--set"].push_back(s);
+  try {
+    return load_scene_for_cli(q, path);
+  } catch (const SceneError& e) {
+    for (size_t k = 0; k < varies.size(); ++k)
+      for (const auto& key : varies[k].keys) {
+        const std::string a = key + "=" + varies[k].values[combo[k]];
+        if (e.note == "set by --set " + a || e.note == "in --set " + a)
+          throw SceneError(e.file, e.path, e.value, e.expected, "set by " + option + " " + varies[k].spec + " as " + a,
+                           e.line, e.column, e.byte);
+      }
+    throw;
+  }
+}
+
+int parse_jobs(const Parsed& p) {
+  const std::string s = p.get("--jobs", "1");
+  char* end = nullptr;
+  const long n = std::strtol(s.c_str(), &end, 10);
+  if (s.empty() || *end != '\0' || n < 1 || n > 1024)
+    throw UsageError("--jobs " + s + ": expected a whole number of parallel runs in [1, 1024]");
+  return int(n);
+}
+
 static int run_main(const Parsed& p) {
   Scene scene;
   try {

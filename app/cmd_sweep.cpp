@@ -28,36 +28,6 @@ namespace furrow::cli {
 
 namespace {
 
-// The scene of one run: the CLI's --set/--threads/--yes plus the run's --vary assignments. An error
-// in a value a --vary wrote names the --vary instead of the --set it became.
-Scene load_run_scene(const Parsed& p, const std::string& path, const std::vector<sweep::Vary>& varies,
-                     const std::vector<size_t>& combo) {
-  Parsed q = p;
-  const auto sets = sweep::run_overrides(varies, combo);
-  for (const auto& s : sets) q.values["--set"].push_back(s);
-  try {
-    return load_scene_for_cli(q, path);
-  } catch (const SceneError& e) {
-    for (size_t k = 0; k < varies.size(); ++k)
-      for (const auto& key : varies[k].keys) {
-        const std::string a = key + "=" + varies[k].values[combo[k]];
-        if (e.note == "set by --set " + a || e.note == "in --set " + a)
-          throw SceneError(e.file, e.path, e.value, e.expected, "set by --vary " + varies[k].spec + " as " + a, e.line,
-                           e.column, e.byte);
-      }
-    throw;
-  }
-}
-
-int parse_jobs(const Parsed& p) {
-  const std::string s = p.get("--jobs", "1");
-  char* end = nullptr;
-  const long n = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || *end != '\0' || n < 1 || n > 1024)
-    throw UsageError("--jobs " + s + ": expected a whole number of parallel runs in [1, 1024]");
-  return int(n);
-}
-
 std::string describe_run(const sweep::SweepRow& r) {
   std::string s;
   for (const auto& b : r.metrics.bodies) {
@@ -100,7 +70,7 @@ int sweep_main(const Parsed& p) {
   std::vector<Scene> scenes;
   try {
     base = load_scene_for_cli(p, scene_path);
-    for (const auto& c : combos) scenes.push_back(load_run_scene(p, scene_path, varies, c));
+    for (const auto& c : combos) scenes.push_back(load_varied_scene(p, scene_path, varies, c, "--vary"));
   } catch (const SceneError& e) {
     std::cerr << "furrow sweep: " << e.what() << "\n";
     return 1;

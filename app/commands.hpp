@@ -1,6 +1,7 @@
 // One function per subcommand, each defined in its own app/cmd_*.cpp.
 #pragma once
 #include "app/cli.hpp"
+#include "app/sweep.hpp"
 #include "engine/scene.hpp"
 
 namespace furrow::cli {
@@ -12,9 +13,16 @@ Command command_render();     // app/cmd_render.cpp
 Command command_demo();       // app/cmd_render.cpp
 Command command_compare();    // app/cmd_render.cpp
 Command command_sweep();      // app/cmd_sweep.cpp
+Command command_study();      // app/cmd_study.cpp
 
 // Shared by run and sweep (app/cmd_run.cpp): the scene from PATH with --set/--threads/--yes
 // applied, and the option specs for those flags. Throws SceneError.
 Scene load_scene_for_cli(const Parsed& p, const std::string& path);
 std::vector<OptionSpec> scene_run_options();
+// load_scene_for_cli plus one combination of sweep/study values (`option` is "--vary" or
+// "--ladder"): an error in a value the option wrote names the option instead of a --set.
+Scene load_varied_scene(const Parsed& p, const std::string& path, const std::vector<sweep::Vary>& varies,
+                        const std::vector<size_t>& combo, const std::string& option);
+// The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
+int parse_jobs(const Parsed& p);
 }  // namespace furrow::cli

@@ -374,14 +374,19 @@ nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlo
 
 }  // namespace
 
+bool RunAnalysis::measures_wedge(const Scene& scene) {
+  const int lead = reference_body_index(scene);
+  if (lead < 0) return false;
+  const auto& fields = scene.outputs.fields;
+  return scene.outputs.frame_interval_s > 0.0 && std::find(fields.begin(), fields.end(), "velocity") != fields.end() &&
+         moves_vertically(scene.bodies[size_t(lead)].motion);
+}
+
 RunAnalysis::RunAnalysis(const Scene& scene) : out_(&scene.outputs), dx_m_(scene.domain.dx_m) {
   lead_ = reference_body_index(scene);
   if (lead_ < 0) return;
-  const Body& b = scene.bodies[size_t(lead_)];
-  lead_name_ = b.name;
-  const auto& fields = scene.outputs.fields;
-  wedge_ = scene.outputs.frame_interval_s > 0.0 &&
-           std::find(fields.begin(), fields.end(), "velocity") != fields.end() && moves_vertically(b.motion);
+  lead_name_ = scene.bodies[size_t(lead_)].name;
+  wedge_ = measures_wedge(scene);
 }
 
 void RunAnalysis::add_step(double t_s, double travel_m, const Vec2& force, const Vec2& velocity) {

@@ -161,6 +161,8 @@ class RunAnalysis {
   // whether frames should be handed to add_frame (velocity stored and the lead body moves
   // vertically)
   bool wants_frames() const { return wedge_; }
+  // The same condition before a run: whether run.json will hold a wedge analysis for `scene`.
+  static bool measures_wedge(const Scene& scene);
   // a frame just rasterized; bodies as in frame.bodies, lead body's velocity
   void add_frame(const FieldFrame& frame, double travel_m, const Vec2& velocity_m_s);
   nlohmann::json to_json() const;

@@ -60,6 +60,15 @@ struct PanelPipeline {
   vtkNew<vtkChartXY> chart;
   std::vector<vtkSmartPointer<vtkTable>> tables;
   vtkNew<vtkTextActor> notes;
+  struct Label {
+    double x, y;
+    std::string text;
+    int color;
+  };
+  std::vector<Label> labels;
+  std::array<double, 2> xr{}, yr{};
+  bool log_x = false, log_y = false;
+  std::vector<vtkSmartPointer<vtkTextActor>> label_actors;
 };
 
 }  // namespace
@@ -129,6 +138,8 @@ RgbImage render_figure(const PlotFigure& fig) {
         cy->InsertNextValue(ser.y[i]);
         xs.push_back(ser.x[i]);
         ys.push_back(ser.y[i]);
+        if (i < ser.point_labels.size() && !ser.point_labels[i].empty())
+          p.labels.push_back({ser.x[i], ser.y[i], ser.point_labels[i], ser.color >= 0 ? ser.color : int(s)});
       }
       t->AddColumn(cx);
       t->AddColumn(cy);
@@ -163,6 +174,7 @@ RgbImage render_figure(const PlotFigure& fig) {
     vtkAxis* ay = chart->GetAxis(vtkAxis::LEFT);
     const auto xr = axis_range(xs, panel.log_x, false);
     const auto yr = axis_range(ys, panel.log_y, panel.y_from_zero);
+    p.xr = xr, p.yr = yr, p.log_x = panel.log_x, p.log_y = panel.log_y;
     ax->SetLogScale(panel.log_x);
     ay->SetLogScale(panel.log_y);
     ax->SetBehavior(vtkAxis::FIXED);
@@ -182,7 +194,7 @@ RgbImage render_figure(const PlotFigure& fig) {
     if (legend_entries > 0) {
       chart->GetLegend()->GetLabelProperties()->SetFontSize(tick_px);
       chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
-      chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::BOTTOM);
+      chart->GetLegend()->SetVerticalAlignment(panel.legend_top ? vtkChartLegend::TOP : vtkChartLegend::BOTTOM);
     }
 
     if (!panel.notes.empty()) {
@@ -210,6 +222,7 @@ RgbImage render_figure(const PlotFigure& fig) {
         crowd[1] += fx > 0.4 && fy > 0.6;
         crowd[2] += fx < 0.6 && fy < 0.4;
       }
+      if (panel.legend_top && legend_entries > 0) crowd[1] += int(xs.size()) + 1;  // the legend is there
       const int best = int(std::min_element(crowd, crowd + 3) - crowd);
       if (best == 1) tp->SetJustificationToRight();
       if (best == 2) tp->SetVerticalJustificationToBottom();
@@ -218,6 +231,40 @@ RgbImage render_figure(const PlotFigure& fig) {
       p.renderer->AddActor2D(p.notes);
     }
     pipes.push_back(std::move(pp));
+  }
+
+  // point labels go where the chart put its plot area, known only after a first render
+  bool any_labels = false;
+  for (const auto& p : pipes) any_labels = any_labels || !p->labels.empty();
+  if (any_labels) {
+    window.window()->Render();
+    for (auto& p : pipes) {
+      int lo[2], hi[2];
+      p->chart->GetPoint1(lo);
+      p->chart->GetPoint2(hi);
+      auto frac = [](double v, const std::array<double, 2>& r, bool log) {
+        return log ? std::log(v / r[0]) / std::log(r[1] / r[0]) : (v - r[0]) / (r[1] - r[0]);
+      };
+      for (const auto& l : p->labels) {
+        auto a = vtkSmartPointer<vtkTextActor>::New();
+        a->SetInput(l.text.c_str());
+        vtkTextProperty* tp = a->GetTextProperty();
+        tp->SetFontSize(tick_px);
+        const auto& c = kPalette[size_t(l.color) % kPalette.size()];
+        tp->SetColor(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
+        // near the right edge the text goes to the left of its point so it stays inside the plot
+        const double fx = frac(l.x, p->xr, p->log_x);
+        if (fx > 0.85) tp->SetJustificationToRight();
+        else tp->SetJustificationToLeft();
+        tp->SetVerticalJustificationToBottom();
+        a->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+        const double px = lo[0] + fx * (hi[0] - lo[0]) + (fx > 0.85 ? -6.0 : 6.0) * scale;
+        const double py = lo[1] + frac(l.y, p->yr, p->log_y) * (hi[1] - lo[1]) + 4.0 * scale;
+        a->GetPositionCoordinate()->SetValue(px, py);
+        p->renderer->AddActor2D(a);
+        p->label_actors.push_back(a);
+      }
+    }
   }
   return window.capture();
 }

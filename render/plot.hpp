@@ -16,6 +16,7 @@ struct PlotSeries {
   bool markers = true;
   bool dashed = false;           // e.g. fits
   int color = -1;                // palette index; -1: the series' position in the panel
+  std::vector<std::string> point_labels;  // optional text beside each point (e.g. a study's dx)
 };
 
 struct PlotPanel {
@@ -23,6 +24,7 @@ struct PlotPanel {
   std::string x_label, y_label;  // with units, e.g. "|z| / D" or "L (m)"
   bool log_x = false, log_y = false;
   bool y_from_zero = false;      // linear y axis includes 0
+  bool legend_top = false;       // legend top right instead of bottom right
   std::vector<PlotSeries> series;
   std::vector<std::string> notes;  // drawn top-left inside the plot area, one per line
 };

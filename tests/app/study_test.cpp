@@ -1,0 +1,283 @@
+// `furrow study`: the convergence arithmetic on made-up ladders with known answers, and the real
+// binary on a tiny scene: its table agrees with the runs it made, it resumes, it keeps finished
+// rungs when stopped, and bad options stop it before anything runs.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "app/study.hpp"
+#include "tests/app/cli_fixture.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using furrow::cli_test::read_text;
+using furrow::study::Rung;
+
+TEST(StudyRichardson, RecoversOrderAndLimitOfAPowerLaw) {
+  // q = 3 + 0.5 h^2 on a halving ladder
+  auto q2 = [](double h) { return 3.0 + 0.5 * h * h; };
+  auto r = furrow::study::richardson(0.04, q2(0.04), 0.02, q2(0.02), 0.01, q2(0.01));
+  ASSERT_TRUE(r.ok) << r.note;
+  EXPECT_NEAR(r.order, 2.0, 1e-9);
+  EXPECT_NEAR(r.extrapolated, 3.0, 1e-12);
+  // q = 1 - 2 h^1.5 on a ladder without a constant ratio
+  auto q15 = [](double h) { return 1.0 - 2.0 * std::pow(h, 1.5); };
+  r = furrow::study::richardson(0.03, q15(0.03), 0.02, q15(0.02), 0.0125, q15(0.0125));
+  ASSERT_TRUE(r.ok) << r.note;
+  EXPECT_NEAR(r.order, 1.5, 1e-9);
+  EXPECT_NEAR(r.extrapolated, 1.0, 1e-12);
+}
+
+TEST(StudyRichardson, RefusesWhatItCannotExtrapolate) {
+  EXPECT_FALSE(furrow::study::richardson(0.04, 1.0, 0.02, 2.0, 0.01, 1.5).ok);   // differences change sign
+  EXPECT_FALSE(furrow::study::richardson(0.04, 1.0, 0.02, 2.0, 0.02, 2.5).ok);   // two rungs at one dx
+  EXPECT_FALSE(furrow::study::richardson(0.04, 1.0, 0.02, 1.0, 0.01, 1.0).ok);   // converged to the digit
+}
+
+// Two settings ("a" first order, "b" second order) converging to the same limit Q0.
+std::vector<Rung> made_up_ladder(double Q0) {
+  std::vector<Rung> rungs;
+  for (const std::string g : {"a", "b"})
+    for (double h : {0.04, 0.02, 0.01}) {
+      Rung r;
+      r.dir = g + std::to_string(h);
+      r.group = g;
+      r.dx_m = h;
+      r.ok = true;
+      r.value = g == "a" ? Q0 + 10.0 * h : Q0 - 50.0 * h * h;
+      r.estimated_particle_steps = r.particle_steps = 1.0 / (h * h * h);
+      r.wall_s = (g == "a" ? 1.0 : 2.0) * r.particle_steps * 1e-6;
+      rungs.push_back(r);
+    }
+  return rungs;
+}
+
+TEST(StudyAnalysis, ErrorsAreMeasuredFromTheExtrapolationOfTheMostExpensiveSettings) {
+  const double Q0 = 100.0;
+  auto rungs = made_up_ladder(Q0);
+  const auto s = furrow::study::analyse(rungs);
+  // at equal particle-steps the slower settings ("b") count as the more expensive ones
+  EXPECT_NE(s.reference_from.find("b"), std::string::npos) << s.reference_from;
+  EXPECT_NEAR(s.reference, Q0, 1e-9);
+  for (const auto& r : rungs) {
+    const double exact = r.group == "a" ? 10.0 * r.dx_m : 50.0 * r.dx_m * r.dx_m;
+    EXPECT_NEAR(r.error_relative, exact / Q0, 1e-9) << r.dir;
+    EXPECT_NEAR(r.extrapolated, Q0, 1e-9) << r.dir;
+    if (r.dx_m == 0.04) {
+      EXPECT_NEAR(r.order, r.group == "a" ? 1.0 : 2.0, 1e-9) << r.dir;
+    } else {
+      EXPECT_TRUE(std::isnan(r.order)) << r.dir;  // needs two finer rungs
+    }
+    if (r.dx_m == 0.01) {
+      EXPECT_EQ(r.diff_finest, 0.0);
+    }
+  }
+}
+
+TEST(StudyPrediction, ALineInParticleStepsThroughTheFinishedRungs) {
+  std::vector<Rung> rungs(4);
+  for (size_t i = 0; i < rungs.size(); ++i) {
+    rungs[i].dir = "r" + std::to_string(i);
+    rungs[i].estimated_particle_steps = 1e6 * std::pow(8.0, double(i));
+    rungs[i].wall_s = 0.3 + 2e-8 * rungs[i].estimated_particle_steps;  // start-up + cost per particle-step
+  }
+  std::string basis;
+  EXPECT_TRUE(std::isnan(furrow::study::predict_wall_s(rungs, rungs[0], &basis)));  // nothing finished
+  rungs[0].ok = true;
+  // one finished rung: proportional to particle-steps
+  EXPECT_NEAR(furrow::study::predict_wall_s(rungs, rungs[1], &basis), rungs[0].wall_s * 8.0, 1e-9);
+  rungs[1].ok = true;
+  EXPECT_NEAR(furrow::study::predict_wall_s(rungs, rungs[3], &basis), rungs[3].wall_s, 1e-9 * rungs[3].wall_s) << basis;
+  // a rung of other settings is predicted from the most expensive finished rung of any settings
+  rungs[2].group = "other";
+  EXPECT_NEAR(furrow::study::predict_wall_s(rungs, rungs[2], &basis), rungs[1].wall_s * 8.0, 1e-9);
+  EXPECT_NE(basis.find("other settings"), std::string::npos);
+}
+
+// ---- the real binary ----------------------------------------------------------------------------
+
+// A 0.1 x 0.05 m bed; a 20 mm plate pushed 15.5 mm down from 0.5 mm above it (as in sweep_test).
+const char* kTinyScene = R"({
+  "schema_version": 1,
+  "name": "tiny",
+  "domain": {"width_m": 0.1, "height_m": 0.07, "dx_m": 0.005},
+  "solver": {"end_time_s": 1.0, "end_displacement_m": 0.0155, "threads": 1},
+  "materials": [{"name": "sand", "model": "ndpm", "grain_density_kg_m3": 2500, "phi_c": 0.6, "mu_s": 0.4}],
+  "beds": [{"material": "sand", "min_m": [0, 0], "max_m": [0.1, 0.05], "packing_fraction": 0.58}],
+  "bodies": [
+    {"name": "plate", "shape": {"type": "box", "size_m": [0.02, 0.01]}, "start_m": [0.05, 0.0555],
+     "motion": {"type": "constant_velocity", "velocity_m_s": [0, -0.1]}}
+  ],
+  "outputs": {"average_window": {"from_m": 0.0085, "to_m": 0.0155}}
+})";
+
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+};
+
+Table read_csv(const fs::path& p) {
+  Table t;
+  std::istringstream in(read_text(p));
+  std::string line;
+  auto split = [](const std::string& l) {
+    std::vector<std::string> out(1);
+    for (char c : l) {
+      if (c == ',') out.emplace_back();
+      else out.back() += c;
+    }
+    return out;
+  };
+  std::getline(in, line);
+  t.header = split(line);
+  while (std::getline(in, line)) {
+    const auto cells = split(line);
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < t.header.size() && i < cells.size(); ++i) row[t.header[i]] = cells[i];
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+class StudyCli : public furrow::cli_test::CliFixture {
+ protected:
+  StudyCli() : CliFixture("furrow_study_") {}
+  void SetUp() override {
+    CliFixture::SetUp();
+    std::ofstream(path("tiny.json")) << kTinyScene;
+  }
+};
+
+TEST_F(StudyCli, TableAgreesWithItsRunsAndARerunReusesThem) {
+  const std::string out = path("s");
+  auto r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005,0.0025", "--out", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table t = read_csv(fs::path(out) / "study.csv");
+  ASSERT_EQ(t.rows.size(), 3u);
+  for (const char* col : {"drag_mean_N_per_m", "diff_from_finest_N_per_m", "extrapolated_N_per_m", "observed_order",
+                          "error_vs_reference_percent", "predicted_wall_s", "wall_s", "particle_steps", "peak_memory_MB"})
+    EXPECT_NE(std::find(t.header.begin(), t.header.end(), col), t.header.end()) << col;
+  std::vector<double> q, h;
+  for (const auto& row : t.rows) {
+    ASSERT_EQ(row.at("status"), "ok") << row.at("note");
+    // the value is the run's own window-mean drag: for a plate moving down, drag = Fy
+    const auto j = nlohmann::json::parse(read_text(fs::path(out) / row.at("rung") / "run.json"));
+    const double fy = j["bodies"][0]["mean_force_N_per_m"][1].get<double>();
+    EXPECT_NEAR(std::stod(row.at("drag_mean_N_per_m")), fy, 1e-6 * std::abs(fy)) << row.at("rung");
+    EXPECT_EQ(std::stod(row.at("particle_steps")), j["particles"].get<double>() * j["steps"].get<double>());
+    q.push_back(std::stod(row.at("drag_mean_N_per_m")));
+    h.push_back(std::stod(row.at("dx_m")));
+  }
+  // rows follow the ladder; the table's extrapolation is the three rungs' Richardson value
+  ASSERT_GT(h[0], h[1]);
+  ASSERT_GT(h[1], h[2]);
+  const auto rich = furrow::study::richardson(h[0], q[0], h[1], q[1], h[2], q[2]);
+  if (rich.ok) {
+    EXPECT_NEAR(std::stod(t.rows[2].at("extrapolated_N_per_m")), rich.extrapolated, 1e-6 * std::abs(rich.extrapolated));
+    EXPECT_NEAR(std::stod(t.rows[0].at("observed_order")), rich.order, 1e-3);
+  }
+  EXPECT_EQ(std::stod(t.rows[2].at("diff_from_finest_N_per_m")), 0.0);
+  // every rung after the first was predicted, and the finest within a factor 3 of what it took
+  EXPECT_TRUE(t.rows[0].at("predicted_wall_s").empty());
+  const double predicted = std::stod(t.rows[2].at("predicted_wall_s")), took = std::stod(t.rows[2].at("wall_s"));
+  EXPECT_GT(predicted, took / 3.0);
+  EXPECT_LT(predicted, took * 3.0);
+  EXPECT_TRUE(fs::exists(fs::path(out) / "study.png"));
+  EXPECT_NE(read_text(fs::path(out) / "study.md").find("| rung |"), std::string::npos);
+
+  // again: nothing reruns; with one rung's directory gone only that one does
+  const auto stamp = fs::last_write_time(fs::path(out) / t.rows[0].at("rung") / "run.json");
+  r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005,0.0025", "--out", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("3 already done"), std::string::npos) << r.err;
+  fs::remove_all(fs::path(out) / t.rows[1].at("rung"));
+  r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005,0.0025", "--out", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("2 already done"), std::string::npos) << r.err;
+  EXPECT_EQ(fs::last_write_time(fs::path(out) / t.rows[0].at("rung") / "run.json"), stamp);
+  const Table t2 = read_csv(fs::path(out) / "study.csv");
+  EXPECT_EQ(t2.rows[1].at("status"), "ok");
+  EXPECT_EQ(t2.rows[0].at("status"), "reused");
+  EXPECT_EQ(t2.rows[1].at("drag_mean_N_per_m"), t.rows[1].at("drag_mean_N_per_m"));  // deterministic
+}
+
+TEST_F(StudyCli, StoppedStudyKeepsFinishedRungsAndFinishesOnRerun) {
+  const std::string out = path("s");
+  const std::string cmd = furrow::cli_test::quote(FURROW_CLI_PATH) + " study " +
+                          furrow::cli_test::quote(path("tiny.json")) +
+                          " --ladder domain.dx_m=0.01,0.005,0.0025 --quiet --out " + furrow::cli_test::quote(out);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", ("exec " + cmd + " >/dev/null 2>&1").c_str(), (char*)nullptr);
+    ::_exit(127);
+  }
+  // stop it once the two cheap rungs are in the table (the finest one takes several times longer)
+  bool two_done = false;
+  for (int i = 0; i < 600 && !two_done; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (!fs::exists(fs::path(out) / "study.csv")) continue;
+    int ok = 0;
+    for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) ok += row.count("status") && row.at("status") == "ok";
+    two_done = ok >= 2;
+  }
+  ASSERT_TRUE(two_done);
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const Table t = read_csv(fs::path(out) / "study.csv");
+  int ok = 0;
+  for (const auto& row : t.rows) ok += row.at("status") == "ok";
+  if (ok == 3) GTEST_SKIP() << "the last rung finished before the stop arrived";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130);
+  EXPECT_EQ(ok, 2);
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+  const auto r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005,0.0025", "--out", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("2 already done"), std::string::npos) << r.err;
+  for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) EXPECT_NE(row.at("status"), "pending");
+}
+
+TEST_F(StudyCli, BadOptionsStopItBeforeAnythingRuns) {
+  struct Case {
+    std::vector<std::string> args;
+    int status;
+    std::vector<std::string> said;
+  };
+  const std::vector<Case> cases = {
+      {{"--ladder", "domain.dxx_m=0.01,0.005"}, 1, {"--ladder domain.dxx_m", "/domain/dxx_m"}},
+      {{"--ladder", "domain.dx_m=0.01,-0.005"}, 1, {"--ladder", "/domain/dx_m", "-0.005"}},
+      {{"--ladder", "domain.dx_m=0.01", "--quantity", "wedge_angle"}, 1, {"--quantity wedge_angle", "velocity"}},
+      {{"--ladder", "domain.dx_m=0.01", "--quantity", "drag"}, 2, {"--quantity drag", "drag_mean"}},
+      {{"--ladder", "domain.dx_m=0.01", "--body", "rod"}, 1, {"--body rod", "plate"}},
+      {{"--ladder", "domain.dx_m=0.01", "--ladder", "domain.dx_m=0.005"}, 2, {"domain.dx_m", "twice"}},
+      {{}, 2, {"--ladder"}},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args = {"study", path("tiny.json"), "--out", path("s")};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const auto r = run(args);
+    EXPECT_EQ(r.status, c.status) << r.err;
+    for (const auto& s : c.said) EXPECT_NE(r.err.find(s), std::string::npos) << "expected '" << s << "' in: " << r.err;
+    EXPECT_FALSE(fs::exists(path("s"))) << "a bad study wrote " << path("s");
+  }
+  // a rung directory that holds a different run is never overwritten
+  auto r = run({"run", path("tiny.json"), "--set", "domain.dx_m=0.01", "--set", "solver.cfl=0.3", "--no-movies",
+                "--quiet", "--out", path("s") + "/tiny_domain.dx_m=0.01"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005", "--out", path("s")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("/solver/cfl"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("s") + "/tiny_domain.dx_m=0.005"));
+}
+
+}  // namespace
