@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "app/calibration.hpp"
 #include "app/commands.hpp"
 #include "app/progress.hpp"
 #include "app/run_movies.hpp"
@@ -68,16 +69,26 @@ static int run_main(const Parsed& p) {
               << " already exists; pass --out DIR for a new run or --force to replace it\n";
     return 1;
   }
+  std::string how;
+  const auto calibration = load_calibration();
+  const double predicted_s = calibration ? predict_run_wall_s(*calibration, scene, &how) : NAN;
+  if (!p.has("--quiet") && std::isfinite(predicted_s))
+    std::fprintf(stderr, "%s: predicted %s of solver time (%s)\n", scene.name.c_str(), format_duration(predicted_s).c_str(),
+                 how.c_str());
   ProgressPrinter progress(scene.name, p.has("--quiet"));
   opt.progress = [&](const RunProgress& r) { progress(r); };
   const RunSummary s = run_scene(scene, opt);
   progress.finish();
 
   const auto& j = s.run_json;
-  std::printf("%s: %zu particles, %lld steps, dt %.3g..%.3g s, %.1f s wall, %.2f M particle-steps/s\n",
-              scene.name.c_str(), j["particles"].get<size_t>(), (long long)j["steps"].get<int64_t>(),
-              j["dt_min_s"].get<double>(), j["dt_max_s"].get<double>(), j["wall_seconds"].get<double>(),
+  std::printf("%s: %zu particles, %lld steps, dt %.3g..%.3g s, %.1f s wall, %.2f M particle-steps/s", scene.name.c_str(),
+              j["particles"].get<size_t>(), (long long)j["steps"].get<int64_t>(), j["dt_min_s"].get<double>(),
+              j["dt_max_s"].get<double>(), j["wall_seconds"].get<double>(),
               j["particle_steps_per_second"].get<double>() / 1e6);
+  if (std::isfinite(predicted_s))
+    std::printf(" (solver %.1f s against %.1f s predicted by the calibration)", j["solver_seconds"].get<double>(),
+                predicted_s);
+  std::printf("\n");
   for (const auto& b : s.bodies)
     std::printf("  %-12s mean F = (%.4g, %.4g) N/m over the averaging window, peak (%.4g, %.4g) N/m\n",
                 b.name.c_str(), b.mean_N_per_m.x(), b.mean_N_per_m.y(), b.peak_N_per_m.x(), b.peak_N_per_m.y());

@@ -11,6 +11,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/calibration.hpp"
 #include "app/commands.hpp"
 #include "engine/fields.hpp"
 #include "engine/scene_io.hpp"
@@ -55,6 +56,7 @@ std::string summary(const Scene& s, const std::string& source) {
   if (t_end < s.solver.end_time_s && ref >= 0)
     os << " (body \"" << s.bodies[size_t(ref)].name << "\" travels " << fmt("%g", s.solver.end_displacement_m) << " m)";
   os << "\n  steps      ~" << steps << ", " << fmt("%.3g", double(steps) * double(particles)) << " particle-steps\n";
+  os << "  wall time  " << predicted_wall_text(s) << "\n";
   if (s.outputs.frame_interval_s > 0.0) {
     os << "  frames     " << long(std::floor(t_end / s.outputs.frame_interval_s + 1e-9)) + 1 << " every "
        << fmt("%g", s.outputs.frame_interval_s) << " s:";

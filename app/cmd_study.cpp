@@ -19,6 +19,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/calibration.hpp"
 #include "app/commands.hpp"
 #include "app/progress.hpp"
 #include "app/study.hpp"
@@ -284,6 +285,7 @@ int study_main(const Parsed& p) {
   sa.sa_handler = on_stop;
   sigaction(SIGTERM, &sa, nullptr);
   sigaction(SIGINT, &sa, nullptr);
+  const auto calibration = load_calibration();  // predicts the first rung, when there is one
   std::map<pid_t, Job> running;
   size_t next = 0, finished = reused, failed = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -292,6 +294,11 @@ int study_main(const Parsed& p) {
       const size_t r = order[next++];
       auto& g = rungs[r];
       g.predicted_wall_s = study::predict_wall_s(rungs, g, &g.predicted_from);
+      if (!std::isfinite(g.predicted_wall_s) && calibration) {
+        std::string how;
+        g.predicted_wall_s = predict_run_wall_s(*calibration, scenes[r], &how);
+        g.predicted_from = "furrow bench calibration, " + how;
+      }
       const fs::path scene_file = out_dir / "scenes" / (g.dir + ".json");
       write_file_atomic(scene_file.string(), format_scene(scenes[r]));
       if (!quiet)
@@ -375,7 +382,7 @@ int study_main(const Parsed& p) {
     remove_stale_partials(out_dir);
     write_outputs(true);
     std::fprintf(stderr, "furrow study: stopped; %zu of %zu rungs are done and in %s/study.csv. Run the same command "
-                 "again to finish the rest.\n", finished - running.size(), rungs.size(), out_dir.string().c_str());
+                 "again to finish the rest.\n", finished, rungs.size(), out_dir.string().c_str());
     return 130;
   }
   write_outputs(true);

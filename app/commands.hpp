@@ -14,6 +14,7 @@ Command command_demo();       // app/cmd_render.cpp
 Command command_compare();    // app/cmd_render.cpp
 Command command_sweep();      // app/cmd_sweep.cpp
 Command command_study();      // app/cmd_study.cpp
+Command command_bench();      // app/cmd_bench.cpp
 
 // Shared by run and sweep (app/cmd_run.cpp): the scene from PATH with --set/--threads/--yes
 // applied, and the option specs for those flags. Throws SceneError.

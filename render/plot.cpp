@@ -146,7 +146,7 @@ RgbImage render_figure(const PlotFigure& fig) {
       p.tables.push_back(t);
       if (cx->GetNumberOfTuples() == 0) continue;
       const auto& c = kPalette[size_t(ser.color >= 0 ? ser.color : int(s)) % kPalette.size()];
-      if (ser.line) {
+      if (ser.line && cx->GetNumberOfTuples() >= 2) {  // VTK cannot draw a line through one point
         vtkPlot* line = chart->AddPlot(vtkChart::LINE);
         line->SetInputData(t, 0, 1);
         line->SetColor(c[0], c[1], c[2], 255);
@@ -157,7 +157,7 @@ RgbImage render_figure(const PlotFigure& fig) {
           pts->SetMarkerSize(float(std::max(5.0, 9.0 * scale)));
         }
         line->SetLegendVisibility(!ser.label.empty());
-      } else if (ser.markers) {
+      } else if (ser.markers || ser.line) {
         vtkPlot* pts = chart->AddPlot(vtkChart::POINTS);
         pts->SetInputData(t, 0, 1);
         pts->SetColor(c[0], c[1], c[2], 255);

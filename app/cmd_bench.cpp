@@ -1,0 +1,127 @@
+// furrow bench: this machine's particle-steps per second for each shape function and model on one
+// and all threads, stored for validate/run/study to predict wall times.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include "app/calibration.hpp"
+#include "app/commands.hpp"
+#include "engine/scene_io.hpp"
+#include "engine/simulation.hpp"
+
+namespace furrow::cli {
+
+namespace {
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      return colon == std::string::npos ? line : line.substr(colon + 2);
+    }
+  return "unknown";
+}
+
+// The single-plate paper case at dx 5 mm (about 115k particles, between the preview and the paper's
+// resolution), the plate already 20 mm into the bed so contact and plastic flow are part of the cost.
+Scene bench_scene(ShapeFunction shape, bool dpm, int threads) {
+  Scene s = parse_scene_text(find_scene_template("plate_intrusion")->text, "<template plate_intrusion>");
+  s.domain.dx_m = 0.005;
+  s.solver.shape_function = shape;
+  s.solver.threads = threads;
+  s.outputs.fields.clear();
+  s.outputs.movies.clear();
+  s.outputs.frame_interval_s = 0.0;
+  s.bodies[0].start_m.y() -= 0.025;
+  if (dpm) {
+    for (auto& m : s.materials) {
+      m.model = MaterialModel::DPM;
+      m.chi = 2.5;
+    }
+    s.effects.dilatancy = true;
+  }
+  return s;
+}
+
+int bench_main(const Parsed& p) {
+  char* end = nullptr;
+  const std::string sec_text = p.get("--seconds", "2");
+  const double seconds = std::strtod(sec_text.c_str(), &end);
+  if (sec_text.empty() || *end != '\0' || !(seconds > 0.0) || seconds > 600.0)
+    throw UsageError("--seconds " + sec_text + ": expected a number of seconds per measurement in (0, 600]");
+  const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<int> thread_counts = {1};
+  if (cores > 1) thread_counts.push_back(cores);
+
+  Calibration c;
+  c.path = p.get("--out", calibration_path());
+  char host[256] = "";
+  ::gethostname(host, sizeof host - 1);
+  c.host = host;
+  c.cpu = cpu_model();
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M", std::localtime(&now));
+  c.date = date;
+
+  const bool quiet = p.has("--quiet");
+  if (!quiet)
+    std::fprintf(stderr, "furrow bench: %s, %d core%s; %.3g s per measurement\n", c.cpu.c_str(), cores,
+                 cores == 1 ? "" : "s", seconds);
+  const char* shape_names[] = {"linear", "quadratic", "cubic"};
+  std::printf("%-10s %-5s %7s %22s\n", "shape", "model", "threads", "M particle-steps/s");
+  for (ShapeFunction shape : {ShapeFunction::Linear, ShapeFunction::Quadratic, ShapeFunction::Cubic})
+    for (bool dpm : {false, true})
+      for (int threads : thread_counts) {
+        Simulation sim(bench_scene(shape, dpm, threads));
+        c.particles = sim.particles().size();
+        for (int i = 0; i < 10; ++i) sim.step();  // first touches of memory and contact warm-up
+        using clock = std::chrono::steady_clock;
+        const auto t0 = clock::now();
+        int64_t steps = 0;
+        double elapsed = 0.0;
+        while (steps < 20 || elapsed < seconds) {
+          sim.step();
+          ++steps;
+          elapsed = std::chrono::duration<double>(clock::now() - t0).count();
+        }
+        const double rate = double(steps) * double(sim.particles().size()) / elapsed;
+        c.entries.push_back({shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate});
+        std::printf("%-10s %-5s %7d %22.2f\n", shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate / 1e6);
+        std::fflush(stdout);
+      }
+  save_calibration(c);
+  std::printf("calibration (%zu particles, plate_intrusion at dx 5 mm) saved to %s\n", c.particles, c.path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command command_bench() {
+  return {"bench",
+          "measure this machine's solver speed so validate, run and study can predict wall times",
+          "furrow bench [--seconds S] [--out FILE]",
+          "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
+          "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
+          "with dilatancy) on one thread and on all cores, prints the particle-steps per second, and\n"
+          "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"
+          "else ~/.config/furrow/calibration.json). `furrow validate` then prints a scene's predicted\n"
+          "solver time, `furrow run` compares against it, and `furrow study` predicts its first rung.\n"
+          "About 12 x (S + setup) seconds; the machine should be otherwise idle for figures that hold.",
+          {{"--seconds", true, false, "seconds per measurement (default 2)", "S"},
+           {"--out", true, false, "calibration file to write (replaced)", "FILE"},
+           {"--quiet", false, false, "no header line on stderr"}},
+          0,
+          0,
+          bench_main};
+}
+
+}  // namespace furrow::cli

@@ -1,0 +1,98 @@
+// `furrow bench` and the wall-time prediction it feeds: the stored calibration, and what
+// `furrow validate` says with and without one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <thread>
+
+#include "tests/app/cli_fixture.hpp"
+
+namespace {
+
+using furrow::cli_test::read_text;
+
+const char* kScene = R"({
+  "schema_version": 1,
+  "name": "tiny",
+  "domain": {"width_m": 0.1, "height_m": 0.07, "dx_m": 0.005},
+  "solver": {"end_time_s": 0.2, "threads": 1},
+  "materials": [{"name": "sand", "model": "ndpm", "grain_density_kg_m3": 2500, "phi_c": 0.6, "mu_s": 0.4}],
+  "beds": [{"material": "sand", "min_m": [0, 0], "max_m": [0.1, 0.05], "packing_fraction": 0.6}]
+})";
+
+class BenchCli : public furrow::cli_test::CliFixture {
+ protected:
+  BenchCli() : CliFixture("furrow_bench_") {}
+  void SetUp() override {
+    CliFixture::SetUp();
+    std::ofstream(path("tiny.json")) << kScene;
+    ::setenv("FURROW_CALIBRATION", path("calibration.json").c_str(), 1);
+  }
+  void TearDown() override {
+    ::unsetenv("FURROW_CALIBRATION");
+    CliFixture::TearDown();
+  }
+  // validate's particle-step estimate and its "wall time" line
+  std::pair<double, std::string> validate() {
+    const auto r = run({"validate", path("tiny.json"), "--brief"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::smatch m;
+    double psteps = NAN;
+    if (std::regex_search(r.err, m, std::regex(R"(, ([0-9.e+]+) particle-steps)"))) psteps = std::stod(m[1]);
+    std::string wall;
+    if (std::regex_search(r.err, m, std::regex(R"(wall time  ([^\n]*))"))) wall = m[1];
+    return {psteps, wall};
+  }
+};
+
+TEST_F(BenchCli, ValidateSaysHowToCalibrateWithoutACalibration) {
+  const auto [psteps, wall] = validate();
+  EXPECT_GT(psteps, 0.0);
+  EXPECT_NE(wall.find("unknown"), std::string::npos) << wall;
+  EXPECT_NE(wall.find("furrow bench"), std::string::npos) << wall;
+}
+
+TEST_F(BenchCli, PredictionIsParticleStepsOverTheCalibratedRate) {
+  // 1 thread: 1e5 particle-steps/s for quadratic NDPM (the scene's settings); other entries differ so
+  // a wrong pick shows
+  nlohmann::json c = {{"host", "test"}, {"cpu", "test"}, {"date", "today"}, {"particles", 1000},
+                      {"entries",
+                       {{{"shape_function", "quadratic"}, {"model", "ndpm"}, {"threads", 1}, {"particle_steps_per_s", 1e5}},
+                        {{"shape_function", "quadratic"}, {"model", "ndpm"}, {"threads", 4}, {"particle_steps_per_s", 4e5}},
+                        {{"shape_function", "linear"}, {"model", "ndpm"}, {"threads", 1}, {"particle_steps_per_s", 1e7}}}}};
+  std::ofstream(path("calibration.json")) << c.dump();
+  const auto [psteps, wall] = validate();
+  ASSERT_GT(psteps, 0.0);
+  std::smatch m;
+  const std::string w = wall;
+  ASSERT_TRUE(std::regex_search(w, m, std::regex(R"(~([0-9]+) s)"))) << wall;
+  EXPECT_EQ(std::stod(m[1]), std::ceil(psteps / 1e5)) << wall;
+  EXPECT_NE(wall.find("1 thread"), std::string::npos) << wall;
+}
+
+TEST_F(BenchCli, BenchStoresAFigureForEveryShapeFunctionModelAndThreadCount) {
+  const auto r = run({"bench", "--seconds", "0.05", "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto c = nlohmann::json::parse(read_text(path("calibration.json")));
+  std::set<std::string> seen;
+  for (const auto& e : c.at("entries")) {
+    EXPECT_GT(e.at("particle_steps_per_s").get<double>(), 0.0);
+    seen.insert(e.at("shape_function").get<std::string>() + "/" + e.at("model").get<std::string>() + "/" +
+                std::to_string(e.at("threads").get<int>()));
+  }
+  const size_t thread_counts = std::thread::hardware_concurrency() > 1 ? 2 : 1;
+  EXPECT_EQ(seen.size(), 3 * 2 * thread_counts);
+  const auto [psteps, wall] = validate();
+  EXPECT_EQ(wall.find("unknown"), std::string::npos) << wall;
+  EXPECT_NE(wall.find("on this machine"), std::string::npos) << wall;
+  // a negative or absurd duration is refused before anything is measured
+  const auto bad = run({"bench", "--seconds", "-1"});
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("--seconds"), std::string::npos) << bad.err;
+}
+
+}  // namespace
