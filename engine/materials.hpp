@@ -5,6 +5,9 @@
 // deviatoric stress s is hypoelastic with a Jaumann rate. Plastic flow is a closed-form return:
 // open material (phi < phi_d) carries no stress; otherwise s is scaled back onto tau = mu P.
 // Plane strain: in-plane kinematics, but s_zz is carried.
+// With effects.rate_dependence the friction is mu(I) = mu + (mu_2 - mu) I / (I0 + I), and the
+// return is implicit in the rate: the plastic increment solves tau_trial - G dgamma = mu(I) P with
+// I evaluated at dgamma / dt, a quadratic with one positive root for any rate and any P >= 0.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -21,6 +24,9 @@ struct MaterialParams {
   double phi_min = 0.45;
   double K = 0.0, G = 0.0;  // bulk and shear moduli (Pa)
   bool separation = true;   // effects.separation: stress-free when open
+  double dmu = 0.0;         // mu_2 - mu: what the rate can add to the friction
+  double I0 = 0.279;
+  double d_m = 0.53e-3;     // grain diameter
 
   static MaterialParams from(const Material& m, bool separation) {
     MaterialParams p;
@@ -32,6 +38,9 @@ struct MaterialParams {
     p.K = m.youngs_modulus_Pa / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
     p.G = m.youngs_modulus_Pa / (2.0 * (1.0 + m.poisson_ratio));
     p.separation = separation;
+    p.dmu = m.mu_2 - m.mu;
+    p.I0 = m.inertial_I0;
+    p.d_m = m.grain_diameter_m;
     return p;
   }
   // friction at dense-state packing phi_d; never negative
@@ -48,9 +57,25 @@ struct PointState {
   double strain_rate_1_s;    // equivalent plastic shear rate of this step
 };
 
-// Shared by both models; Dilatancy selects the DPM state law at compile time so an NDPM run
-// carries no per-particle branch or state for it.
-template <bool Dilatancy>
+// The plastic shear increment of the mu(I) return: tau_trial - G x = P (mu_s + dmu I / (I0 + I)),
+// I = x d / (dt sqrt(P / rho_g)). With m = dt sqrt(P / rho_g) / d (so I = x / m) it is the quadratic
+//   G x^2 + (G I0 m + P dmu - A) x - A I0 m = 0,   A = tau_trial - mu_s P > 0,
+// whose positive root is taken in the form that does not cancel: at P -> 0 (m = 0) it tends to
+// (A - P dmu) / G, the rate-independent return at mu_2, so large rates and small pressures are safe.
+inline double rate_dependent_increment(double tau_trial, double P, double mu_s, double dt, const MaterialParams& p,
+                                       double* rate_part) {
+  const double A = tau_trial - mu_s * P;
+  const double m = dt * std::sqrt(P / p.rho_g) / p.d_m;
+  const double b = p.G * p.I0 * m + P * p.dmu - A;
+  const double disc = std::sqrt(b * b + 4.0 * p.G * A * p.I0 * m);
+  const double x = b >= 0.0 ? 2.0 * A * p.I0 * m / (b + disc) : (disc - b) / (2.0 * p.G);
+  *rate_part = x > 0.0 ? p.dmu * x / (p.I0 * m + x) : 0.0;  // dmu I / (I0 + I)
+  return x;
+}
+
+// Shared by both models; Dilatancy selects the DPM state law and Rate the mu(I) friction at
+// compile time, so a run carries no per-particle branch or state for an effect it does not use.
+template <bool Dilatancy, bool Rate = false>
 struct PlasticityModel {
   MaterialParams p;
 
@@ -96,14 +121,18 @@ struct PlasticityModel {
       return;
     }
     // plastic: equivalent shear strain increment from the overshoot (tau = G * gamma)
-    const double dgamma = (tau - tau_max) / p.G;
+    double rate_part = 0.0;
+    const double dgamma = Rate ? rate_dependent_increment(tau, std::max(P, 0.0), p.friction(phi_d), dt, p, &rate_part)
+                               : (tau - tau_max) / p.G;
+    // from the friction, not tau - G dgamma: at high rates tau_trial >> tau and the difference cancels
+    if constexpr (Rate) tau_max = (p.friction(phi_d) + rate_part) * std::max(P, 0.0);
     if (Dilatancy) {
       // d phi_d / d gamma = -chi phi_c (phi_d - phi_c): exact relaxation over the increment,
       // monotone toward phi_c from either side
       phi_d = p.phi_c + (phi_d - p.phi_c) * std::exp(-p.chi * p.phi_c * dgamma);
       s.phi_d = phi_d;
       P = p.K * std::log(phi / phi_d);
-      tau_max = p.friction(phi_d) * std::max(P, 0.0);
+      tau_max = (p.friction(phi_d) + rate_part) * std::max(P, 0.0);
     }
     const double scale = tau > 0.0 ? tau_max / tau : 0.0;
     s.sxx *= scale;

@@ -27,6 +27,12 @@ struct Material {
   double phi_min = 0.45;                // DPM: phi_d resets here when material opens below it
   double youngs_modulus_Pa = 5.0e6;     // small elastic part: "just stiff enough"
   double poisson_ratio = 0.3;
+  // mu(I) rheology, used only with effects.rate_dependence: the friction gains
+  // (mu_2 - mu) / (1 + I0 / I), I = gamma_dot_p d / sqrt(P / rho_g) (Jop, Forterre & Pouliquen 2006;
+  // defaults: their glass beads, mu_2 - mu_s = 0.26, I0 = 0.279, d = 0.53 mm)
+  double mu_2 = 0.66;
+  double inertial_I0 = 0.279;
+  double grain_diameter_m = 0.53e-3;
 };
 
 struct Bed {
@@ -80,6 +86,7 @@ struct Effects {
   Vec2 gravity_m_s2{0.0, -9.81};
   bool dilatancy = false;        // DPM state evolution; forced off for NDPM materials
   bool separation = true;        // stress-free when open (rho < rho_d)
+  bool rate_dependence = false;  // mu(I): friction grows with the inertial number (off: the paper's models)
   bool body_friction = true;
   bool wall_friction = true;
 };

@@ -291,6 +291,10 @@ Material read_material(const Ctx& c, const json& j, const std::string& path) {
   }
   m.youngs_modulus_Pa = num(o, "youngs_modulus_Pa", kPositive, "Pa", 5.0e6);
   m.poisson_ratio = num(o, "poisson_ratio", half_open(0.0, 0.5), "", 0.3);
+  // mu(I): the rate part is mu_2 - mu on top of the static friction (of phi_d for DPM)
+  m.mu_2 = num(o, "mu_2", closed(m.mu, kFriction.hi), "", std::min(m.mu + 0.26, kFriction.hi), dpm ? " (at least mu_c)" : " (at least mu_s)");
+  m.inertial_I0 = num(o, "I0", Range{0.0, 10.0, true, false}, "", 0.279);
+  m.grain_diameter_m = num(o, "grain_diameter_m", Range{0.0, 0.1, true, false}, "m", 0.53e-3);
   o.finish();
   return m;
 }
@@ -461,6 +465,7 @@ Effects read_effects(const Ctx& c, const json* j, const Scene& s) {
   e.separation = boolean(o, "separation", true);
   e.body_friction = boolean(o, "body_friction", true);
   e.wall_friction = boolean(o, "wall_friction", true);
+  e.rate_dependence = boolean(o, "rate_dependence", false);
   o.finish();
   return e;
 }

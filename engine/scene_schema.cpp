@@ -100,9 +100,9 @@ const KeyList kDomainKeys = {"width_m", "height_m", "dx_m"};
 const KeyList kSolverKeys = {"shape_function", "particles_per_cell_1d", "cfl", "flip_blend", "contact", "end_time_s",
                              "end_displacement_m", "threads", "max_steps"};
 const KeyList kMaterialNdpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_s",
-                                   "youngs_modulus_Pa", "poisson_ratio"};
+                                   "youngs_modulus_Pa", "poisson_ratio", "mu_2", "I0", "grain_diameter_m"};
 const KeyList kMaterialDpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_c", "chi",
-                                  "phi_min", "youngs_modulus_Pa", "poisson_ratio"};
+                                  "phi_min", "youngs_modulus_Pa", "poisson_ratio", "mu_2", "I0", "grain_diameter_m"};
 const KeyList kBedKeys = {"material", "min_m", "max_m", "packing_fraction", "k0", "geostatic"};
 const KeyList kBodyKeys = {"name", "shape", "start_m", "motion", "friction"};
 const KeyList kBoxKeys = {"type", "size_m"};
@@ -116,7 +116,7 @@ const KeyList kWallsKeys = {"left", "right", "bottom", "top"};
 const KeyList kFrictionWallKeys = {"type", "friction"};
 const KeyList kPlainWallKeys = {"type"};
 const KeyList kEffectsKeys = {"gravity", "gravity_m_s2", "dilatancy", "separation", "body_friction",
-                              "wall_friction"};
+                              "wall_friction", "rate_dependence"};
 const KeyList kOutputsKeys = {"frame_interval_s", "fields", "movies", "force_interval_s",
                               "average_window"};
 const KeyList kWindowKeys = {"from_s", "to_s", "from_m", "to_m"};

@@ -81,6 +81,9 @@ J to_json(const Scene& s) {
     }
     mj["youngs_modulus_Pa"] = m.youngs_modulus_Pa;
     mj["poisson_ratio"] = m.poisson_ratio;
+    mj["mu_2"] = m.mu_2;
+    mj["I0"] = m.inertial_I0;
+    mj["grain_diameter_m"] = m.grain_diameter_m;
     j["materials"].push_back(mj);
   }
   j["beds"] = J::array();
@@ -130,6 +133,7 @@ J to_json(const Scene& s) {
   effects["separation"] = s.effects.separation;
   effects["body_friction"] = s.effects.body_friction;
   effects["wall_friction"] = s.effects.wall_friction;
+  effects["rate_dependence"] = s.effects.rate_dependence;
   j["effects"] = effects;
   J out = J::object();
   out["frame_interval_s"] = s.outputs.frame_interval_s;

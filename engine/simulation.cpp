@@ -75,10 +75,17 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   }
   // plastic strain and its rate are kept only when a stored field needs them
   for (const auto& f : scene_.outputs.fields) track_plastic_ |= f == "strain_rate" || f == "plastic_strain";
-  if (dilatancy_)
-    constitutive_ = track_plastic_ ? &Simulation::constitutive_update<true, true> : &Simulation::constitutive_update<true, false>;
-  else
-    constitutive_ = track_plastic_ ? &Simulation::constitutive_update<false, true> : &Simulation::constitutive_update<false, false>;
+  auto pick_law = [&](auto rate) {
+    constexpr bool R = decltype(rate)::value;
+    if (dilatancy_)
+      constitutive_ = track_plastic_ ? &Simulation::constitutive_update<true, true, R>
+                                     : &Simulation::constitutive_update<true, false, R>;
+    else
+      constitutive_ = track_plastic_ ? &Simulation::constitutive_update<false, true, R>
+                                     : &Simulation::constitutive_update<false, false, R>;
+  };
+  if (scene_.effects.rate_dependence) pick_law(std::true_type{});
+  else pick_law(std::false_type{});
   if (!track_plastic_) {
     p_.plastic_strain = {};
     p_.strain_rate = {};
@@ -678,10 +685,10 @@ void Simulation::grid_to_particles() {
   stats_.max_speed_m_s = std::sqrt(vmax2);
 }
 
-template <bool Dilatancy, bool Track>
+template <bool Dilatancy, bool Track, bool Rate>
 void Simulation::constitutive_update() {
   const double dt = dt_s_;
-  std::vector<PlasticityModel<Dilatancy>> models;
+  std::vector<PlasticityModel<Dilatancy, Rate>> models;
   for (const auto& m : materials_) models.push_back({m});
   auto& P = p_;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, P.size(), kGrain), [&](const auto& r) {

@@ -127,7 +127,7 @@ class Simulation {
   void contact_nodes();
   void contact_walls();
   template <class Kernel, bool Flip> void grid_to_particles();
-  template <bool Dilatancy, bool Track> void constitutive_update();
+  template <bool Dilatancy, bool Track, bool Rate> void constitutive_update();
   void advance_bodies();
   void reorder_particles();
 

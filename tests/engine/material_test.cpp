@@ -184,3 +184,89 @@ TEST(Dpm, OpeningBelowPhiMinResetsState) {
   model.update(1.0, 0.05, 0.0, 0.0, 0.0, mass, t);
   EXPECT_EQ(t.phi_d, 0.58);
 }
+
+// ---- mu(I) (effects.rate_dependence) ------------------------------------------------------------
+
+namespace {
+
+MaterialParams mu_i(MaterialModel model) {
+  Material m = test_scenes::glass_beads(0.38);
+  m.model = model;
+  m.chi = model == MaterialModel::DPM ? 2.0 : 0.0;
+  m.mu_2 = 0.64;  // Jop, Forterre & Pouliquen (2006), glass beads
+  m.inertial_I0 = 0.279;
+  m.grain_diameter_m = 0.53e-3;
+  return MaterialParams::from(m, true);
+}
+
+double mu_of_I(const MaterialParams& p, double mu_s, double I) { return mu_s + p.dmu / (1.0 + p.I0 / I); }
+
+}  // namespace
+
+// Steady simple shear at fixed volume (a homogeneous layer): once the elastic strain stops
+// changing, the plastic rate equals the imposed rate, so tau/P must be mu(I) of the imposed I.
+TEST(RateDependence, SteadySimpleShearGivesMuOfI) {
+  const auto p = mu_i(MaterialModel::NDPM);
+  PlasticityModel<false, true> model{p};
+  const double P0 = 1000.0, mass = 1e-3;
+  for (double I : {0.01, 0.1, 1.0}) {
+    const double gdot = I * std::sqrt(P0 / p.rho_g) / p.d_m;  // imposed engineering shear rate dvx/dy
+    const double dt = 1e-4 / gdot;                             // 1e-4 strain per step
+    PointState s = dense_point(p, P0, p.phi_c, mass);
+    for (int i = 0; i < 20000; ++i) model.update(dt, 0.0, gdot, 0.0, 0.0, mass, s);
+    const double ratio = tau_of(s) / s.pressure_Pa;
+    EXPECT_NEAR(s.pressure_Pa, P0, 1e-9 * P0) << "fixed volume keeps the pressure";
+    EXPECT_NEAR(ratio, mu_of_I(p, 0.38, I), 0.02 * mu_of_I(p, 0.38, I)) << "I = " << I;
+    EXPECT_NEAR(s.strain_rate_1_s, gdot, 0.02 * gdot) << "steady: plastic rate = imposed rate";
+  }
+}
+
+// The implicit return at its extremes: P -> 0 and I -> infinity, P large and I -> 0. The friction
+// stays between mu_s and mu_2, the stress finite, and the static limit is the rate-independent law.
+TEST(RateDependence, ReturnIsBoundedAtExtremeRatesAndPressures) {
+  const auto p = mu_i(MaterialModel::NDPM);
+  PlasticityModel<false, true> rate{p};
+  PlasticityModel<false, false> plain{p};
+  const double mass = 1e-3;
+  for (double P0 : {1e-9, 1e-3, 1.0, 1e3, 1e6})
+    for (double gdot : {1e-6, 1.0, 1e3, 1e8}) {
+      PointState s = dense_point(p, P0, p.phi_c, mass);
+      for (int i = 0; i < 50; ++i) rate.update(1e-5, 0.0, gdot, 0.0, 0.0, mass, s);
+      const double r = tau_of(s) / s.pressure_Pa;
+      ASSERT_TRUE(std::isfinite(r)) << P0 << " " << gdot;
+      EXPECT_LE(r, 0.64 * (1.0 + 1e-9)) << "P " << P0 << " rate " << gdot;
+      EXPECT_GE(tau_of(s), 0.0);
+    }
+  // vanishing rate: identical to the rate-independent return at mu_s within round-off
+  PointState a = dense_point(p, 1e3, p.phi_c, mass), b = a;
+  for (int i = 0; i < 2000; ++i) {
+    rate.update(1e-5, 0.0, 1e-3, 0.0, 0.0, mass, a);
+    plain.update(1e-5, 0.0, 1e-3, 0.0, 0.0, mass, b);
+  }
+  EXPECT_NEAR(tau_of(a), tau_of(b), 1e-6 * tau_of(b));
+  // with mu_2 = mu_s the effect is the rate-independent law exactly (to round-off)
+  Material m = test_scenes::glass_beads(0.38);
+  m.mu_2 = 0.38;
+  const auto same = MaterialParams::from(m, true);
+  PlasticityModel<false, true> flat{same};
+  PlasticityModel<false, false> flat_plain{same};
+  PointState c = dense_point(same, 1e3, same.phi_c, mass), d = c;
+  for (int i = 0; i < 2000; ++i) {
+    flat.update(1e-5, 0.3, 50.0, -20.0, -0.2, mass, c);
+    flat_plain.update(1e-5, 0.3, 50.0, -20.0, -0.2, mass, d);
+  }
+  EXPECT_NEAR(tau_of(c), tau_of(d), 1e-9 * tau_of(d));
+  EXPECT_NEAR(c.pressure_Pa, d.pressure_Pa, 1e-9 * d.pressure_Pa);
+}
+
+// DPM: the rate part adds to the state-dependent static friction mu_c + (phi_d - phi_c) chi.
+TEST(RateDependence, DpmAddsTheRatePartToTheStateFriction) {
+  const auto p = mu_i(MaterialModel::DPM);
+  PlasticityModel<true, true> model{p};
+  const double P0 = 1000.0, mass = 1e-3, I = 0.3;
+  const double gdot = I * std::sqrt(P0 / p.rho_g) / p.d_m, dt = 1e-4 / gdot;
+  PointState s = dense_point(p, P0, p.phi_c, mass);  // at phi_c: phi_d stays at phi_c under shear
+  for (int i = 0; i < 20000; ++i) model.update(dt, 0.0, gdot, 0.0, 0.0, mass, s);
+  EXPECT_NEAR(s.phi_d, p.phi_c, 1e-12);
+  EXPECT_NEAR(tau_of(s) / s.pressure_Pa, mu_of_I(p, p.friction(s.phi_d), I), 0.02 * mu_of_I(p, 0.38, I));
+}

@@ -290,6 +290,10 @@ std::vector<BadCase> bad_cases() {
       {"unknown solver key", with(P, [](json& j) { j["solver"]["cfl_number"] = 0.3; }), {}, "/solver/cfl_number", "keys here"},
       {"unknown contact method", with(P, [](json& j) { j["solver"]["contact"] = "penalty"; }), {}, "/solver/contact", "\"particle\""},
       {"contact method not a string", plain(P), {"solver.contact=2"}, "/solver/contact", "\"node\""},
+      {"mu_2 below mu_s", plain(P), {"materials.0.mu_2=0.2"}, "/materials/0/mu_2", "at least mu_s"},
+      {"I0 not positive", plain(P), {"materials.0.I0=0"}, "/materials/0/I0", "(0, 10]"},
+      {"grain diameter negative", plain(P), {"materials.0.grain_diameter_m=-0.001"}, "/materials/0/grain_diameter_m", "m"},
+      {"rate_dependence not a boolean", plain(P), {"effects.rate_dependence=1"}, "/effects/rate_dependence", "true or false"},
       {"unknown shape key", with(P, [](json& j) { j["bodies"][0]["shape"]["sizem"] = 1; }), {}, "/bodies/0/shape/sizem", "did you mean \"size_m\""},
       {"unknown knot key", with(P, [](json& j) {
          j["bodies"][0]["motion"] = json::parse(R"({"type": "path", "knots": [{"t_s": 0, "velocity": [0, -0.1]}]})");
