@@ -28,12 +28,6 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-std::string csv_quote(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-  return q + "\"";
-}
 
 // Finished rungs with a value, by group, coarse to fine (largest dx first, then fewest particle-steps).
 std::map<std::string, std::vector<Rung*>> by_group(std::vector<Rung>& rungs) {
@@ -268,13 +262,13 @@ double predict_wall_s(const std::vector<Rung>& rungs, const Rung& r, std::string
 std::string study_csv(const std::vector<sweep::Vary>& ladders, Quantity q, const std::vector<Rung>& rungs) {
   const std::string u = q == Quantity::WedgeAngle ? "_deg" : "_N_per_m";
   std::string s = "rung";
-  for (const auto& l : ladders) s += "," + csv_quote(l.column);
+  for (const auto& l : ladders) s += "," + sweep::csv_quote(l.column);
   s += ",dx_m,status," + quantity_column(q) + ",diff_from_finest" + u + ",extrapolated" + u +
        ",diff_from_extrapolated" + u + ",observed_order,error_vs_reference_percent,predicted_wall_s,wall_s,particles,"
        "steps,particle_steps,peak_memory_MB,state_memory_MB,threads,note\n";
   for (const auto& r : rungs) {
-    s += csv_quote(r.dir);
-    for (const auto& v : r.values) s += "," + csv_quote(v);
+    s += sweep::csv_quote(r.dir);
+    for (const auto& v : r.values) s += "," + sweep::csv_quote(v);
     const bool done = r.ok;
     s += "," + fmt("%.9g", r.dx_m) + "," + (done ? (r.reused ? "reused" : "ok") : (r.error.empty() ? "pending" : "failed"));
     s += "," + fmt("%.9g", r.value) + "," + fmt("%.9g", r.diff_finest) + "," + fmt("%.9g", r.extrapolated) + "," +
@@ -283,7 +277,7 @@ std::string study_csv(const std::vector<sweep::Vary>& ladders, Quantity q, const
          (done ? fmt("%.0f", r.particles) : "") + "," + (done ? fmt("%.0f", r.steps) : "") + "," +
          (done ? fmt("%.6g", r.particle_steps) : "") + "," + (done ? fmt("%.1f", r.peak_resident_bytes / 1e6) : "") +
          "," + (done ? fmt("%.2f", r.state_bytes / 1e6) : "") + "," + (done ? std::to_string(r.threads) : "") + "," +
-         csv_quote(r.error) + "\n";
+         sweep::csv_quote(r.error) + "\n";
   }
   return s;
 }

@@ -419,12 +419,6 @@ std::string num_cell(double v) {
   return buf;
 }
 
-std::string csv_quote(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-  return q + "\"";
-}
 
 std::vector<Column> columns(const std::vector<Vary>& varies, const std::vector<SweepRow>& rows) {
   std::vector<Column> cols;
@@ -528,6 +522,13 @@ std::vector<std::pair<std::string, std::string>> sweep_columns(const std::vector
   std::vector<std::pair<std::string, std::string>> out;
   for (const auto& c : columns(varies, rows)) out.emplace_back(c.name, c.meaning);
   return out;
+}
+
+std::string csv_quote(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return q + "\"";
 }
 
 }  // namespace furrow::sweep

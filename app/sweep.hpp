@@ -115,6 +115,9 @@ struct SweepRow {
   RunMetrics metrics;
 };
 
+// A CSV cell: quoted (with doubled quotes) when it holds a comma, quote or newline.
+std::string csv_quote(const std::string& s);
+
 // sweep.csv: a header with units, one row per run (see the column list in cmd_sweep's help).
 std::string sweep_csv(const std::vector<Vary>& varies, const std::vector<SweepRow>& rows);
 
