@@ -1,5 +1,6 @@
 // furrow run: scene file -> Scene -> Simulation -> run directory (+ movies rendered from the
 // stored frames).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -41,6 +42,25 @@ Scene load_varied_scene(const Parsed& p, const std::string& path, const std::vec
       }
     throw;
   }
+}
+
+std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option, const std::string& if_none) {
+  std::vector<sweep::Vary> varies;
+  std::vector<std::string> keys;
+  for (const auto& spec : p.all(option)) {
+    try {
+      varies.push_back(sweep::parse_vary(spec));
+    } catch (const sweep::VaryError& e) {
+      throw UsageError(option + ": " + e.what());
+    }
+    for (const auto& k : varies.back().keys) {
+      if (std::find(keys.begin(), keys.end(), k) != keys.end())
+        throw UsageError(option + ": key " + k + " is varied twice");
+      keys.push_back(k);
+    }
+  }
+  if (varies.empty()) throw UsageError(if_none);
+  return varies;
 }
 
 int parse_jobs(const Parsed& p) {

@@ -98,21 +98,8 @@ int study_main(const Parsed& p) {
   const bool quiet = p.has("--quiet");
 
   // ---- everything is checked before anything runs or is written ----
-  std::vector<sweep::Vary> ladders;
-  for (const auto& spec : p.all("--ladder")) {
-    try {
-      ladders.push_back(sweep::parse_vary(spec));
-    } catch (const sweep::VaryError& e) {
-      throw UsageError(std::string("--ladder: ") + e.what());
-    }
-  }
-  if (ladders.empty()) throw UsageError("nothing to study: give at least one --ladder KEY=VALUES, e.g. --ladder domain.dx_m=0.01,0.005,0.0025");
-  std::vector<std::string> keys;
-  for (const auto& l : ladders)
-    for (const auto& k : l.keys) {
-      if (std::find(keys.begin(), keys.end(), k) != keys.end()) throw UsageError("--ladder: key " + k + " is given twice");
-      keys.push_back(k);
-    }
+  const std::vector<sweep::Vary> ladders = parse_varies(
+      p, "--ladder", "nothing to study: give at least one --ladder KEY=VALUES, e.g. --ladder domain.dx_m=0.01,0.005,0.0025");
   study::Quantity q;
   try {
     q = study::parse_quantity(p.get("--quantity", "drag_mean"));

@@ -48,21 +48,7 @@ int sweep_main(const Parsed& p) {
   const bool quiet = p.has("--quiet");
 
   // ---- everything is checked before anything is written ----
-  std::vector<sweep::Vary> varies;
-  for (const auto& spec : p.all("--vary")) {
-    try {
-      varies.push_back(sweep::parse_vary(spec));
-    } catch (const sweep::VaryError& e) {
-      throw UsageError(e.what());
-    }
-  }
-  if (varies.empty()) throw UsageError("nothing to sweep: give at least one --vary KEYS=VALUES");
-  std::vector<std::string> keys;
-  for (const auto& v : varies)
-    for (const auto& k : v.keys) {
-      if (std::find(keys.begin(), keys.end(), k) != keys.end()) throw UsageError("--vary: key " + k + " is varied twice");
-      keys.push_back(k);
-    }
+  const std::vector<sweep::Vary> varies = parse_varies(p, "--vary", "nothing to sweep: give at least one --vary KEYS=VALUES");
   const int jobs_asked = parse_jobs(p);
 
   Scene base;

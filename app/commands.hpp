@@ -24,6 +24,9 @@ std::vector<OptionSpec> scene_run_options();
 // "--ladder"): an error in a value the option wrote names the option instead of a --set.
 Scene load_varied_scene(const Parsed& p, const std::string& path, const std::vector<sweep::Vary>& varies,
                         const std::vector<size_t>& combo, const std::string& option);
+// The --vary / --ladder specs (each KEYS=VALUES, no key twice); throws UsageError naming `option`,
+// with `if_none` when there are none.
+std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option, const std::string& if_none);
 // The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
 int parse_jobs(const Parsed& p);
 }  // namespace furrow::cli
