@@ -147,6 +147,44 @@ double median_finite(std::vector<double> values);
 // The slip-line wedge apex angle pi/2 - atan(mu) in degrees (see the header comment).
 double slip_line_apex_angle_deg(double mu);
 
+// ---------------------------------------------------------------- column collapse
+// A released column: a scene with no bodies whose beds leave a side free. The column's back is the
+// wall its beds touch (both sides free: it spreads both ways and lengths are half-widths from its
+// centre line); L0 and H0 are the beds' extent. At each sample:
+//   front  = distance from the back to the point beyond which 0.5% of the material points lie,
+//            plus half a point's size (a few grains thrown ahead do not count, as in experiments
+//            that read the front off the continuous deposit);
+//   height = highest point top (centre + half its size) above the floor.
+// Runout (Lf - L0) / L0 and Hf / H0 from the last sample; "settled" when the front moved less than
+// 1% of L0 over the last tenth of the run.
+struct CollapseGeometry {
+  bool active = false;
+  int side = 0;  // +1: spreads toward +x from a wall at back_x_m; -1: toward -x; 0: both ways
+  double back_x_m = 0.0, floor_y_m = 0.0, L0_m = 0.0, H0_m = 0.0;
+};
+CollapseGeometry collapse_geometry(const Scene& scene);
+
+struct CollapseSample {
+  double t_s = 0.0, front_m = 0.0, height_m = 0.0;
+};
+CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g, double t_s);
+
+class CollapseAnalysis {
+ public:
+  explicit CollapseAnalysis(const Scene& scene);
+  bool active() const { return g_.active; }
+  // samples every `interval_s` of simulated time (frame interval, else end time / 100); `last`:
+  // the run's final state, sampled unless it just was
+  void add_step(double t_s, const ParticleView& p, bool last = false);
+  nlohmann::json to_json() const;
+  const std::vector<CollapseSample>& samples() const { return samples_; }
+
+ private:
+  CollapseGeometry g_;
+  double interval_s_ = 0.0, next_s_ = 0.0;
+  std::vector<CollapseSample> samples_;
+};
+
 // ---------------------------------------------------------------- run.json hook
 // Collects what the "analysis" section of run.json needs while a run goes, at no cost when the
 // scene has no moving body. Drag of the lead body = -(force . unit velocity), the media's

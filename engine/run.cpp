@@ -135,6 +135,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   ForceLog forces((tmp_dir / "forces.csv").string(), scene);
   ForceStats stats(scene);
   RunAnalysis analysis(scene);  // run.json "analysis": drag statistics, wedge per frame
+  CollapseAnalysis collapse(scene);  // run.json "collapse": runout and height of a released column
 
   const auto& out = scene.outputs;
   std::vector<std::string> fields;
@@ -191,6 +192,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   };
 
   if (frames_on) write_frame();
+  if (collapse.active()) collapse.add_step(0.0, sim.particle_view());
   const auto loop0 = clock::now();
   int64_t contact_sweeps = 0, contact_unconverged = 0, contact_points_max = 0;
   int contact_sweeps_max = 0;
@@ -212,9 +214,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
       analysis.add_step(sim.time_s(), sim.lead_body_travel_m(), lead.force_N_per_m, lead.velocity_m_s);
     }
     if (frames_on && sim.time_s() >= next_frame_s - 1e-12) write_frame();
+    if (collapse.active()) collapse.add_step(sim.time_s(), sim.particle_view());
     report(false);
   }
   const double loop_s = std::chrono::duration<double>(clock::now() - loop0).count();
+  if (collapse.active()) collapse.add_step(sim.time_s(), sim.particle_view(), true);
   forces.flush(sim);
   forces.close();
   report(true);
@@ -248,6 +252,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
                            {"peak_force_N_per_m", vec_json(b.peak_N_per_m)},
                            {"window_steps", b.window_samples}});
   if (analysis.active()) j["analysis"] = analysis.to_json();
+  if (collapse.active()) j["collapse"] = collapse.to_json();
   if (!scene.bodies.empty() && scene.solver.contact == ContactMethod::Particle)
     j["contact"] = {{"method", "particle"},
                     {"points_max", contact_points_max},
