@@ -77,7 +77,8 @@ int bench_main(const Parsed& p) {
     std::fprintf(stderr, "furrow bench: %s, %d core%s; %.3g s per measurement\n", c.cpu.c_str(), cores,
                  cores == 1 ? "" : "s", seconds);
   const char* shape_names[] = {"linear", "quadratic", "cubic"};
-  std::printf("%-10s %-5s %7s %22s\n", "shape", "model", "threads", "M particle-steps/s");
+  std::printf("%-10s %-5s %7s %19s   share of a step (%%): %5s %5s %5s %7s %5s %6s %7s\n", "shape", "model", "threads",
+              "M particle-steps/s", "sort", "p2g", "grid", "contact", "g2p", "const.", "reorder");
   for (ShapeFunction shape : {ShapeFunction::Linear, ShapeFunction::Quadratic, ShapeFunction::Cubic})
     for (bool dpm : {false, true})
       for (int threads : thread_counts) {
@@ -86,6 +87,7 @@ int bench_main(const Parsed& p) {
         for (int i = 0; i < 10; ++i) sim.step();  // first touches of memory and contact warm-up
         using clock = std::chrono::steady_clock;
         const auto t0 = clock::now();
+        const PhaseSeconds before = sim.phase_seconds();
         int64_t steps = 0;
         double elapsed = 0.0;
         while (steps < 20 || elapsed < seconds) {
@@ -95,7 +97,13 @@ int bench_main(const Parsed& p) {
         }
         const double rate = double(steps) * double(sim.particles().size()) / elapsed;
         c.entries.push_back({shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate});
-        std::printf("%-10s %-5s %7d %22.2f\n", shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate / 1e6);
+        const PhaseSeconds& ph = sim.phase_seconds();
+        const double step_s = ph.total() - before.total();
+        auto share = [&](double now, double then) { return 100.0 * (now - then) / step_s; };
+        std::printf("%-10s %-5s %7d %19.2f   %21s %5.1f %5.1f %5.1f %7.1f %5.1f %6.1f %7.1f\n", shape_names[int(shape)],
+                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.sort, before.sort), share(ph.p2g, before.p2g),
+                    share(ph.grid, before.grid), share(ph.contact, before.contact), share(ph.g2p, before.g2p),
+                    share(ph.constitutive, before.constitutive), share(ph.reorder, before.reorder));
         std::fflush(stdout);
       }
   save_calibration(c);
@@ -111,7 +119,9 @@ Command command_bench() {
           "furrow bench [--seconds S] [--out FILE]",
           "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
-          "with dilatancy) on one thread and on all cores, prints the particle-steps per second, and\n"
+          "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
+          "share of a step each phase takes (sort, P2G, grid update, body and wall contact, G2P,\n"
+          "constitutive update, particle reorder), and\n"
           "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"
           "else ~/.config/furrow/calibration.json). `furrow validate` then prints a scene's predicted\n"
           "solver time, `furrow run` compares against it, and `furrow study` predicts its first rung.\n"

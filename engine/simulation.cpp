@@ -6,6 +6,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -156,20 +157,36 @@ double Simulation::next_dt_s() const {
 }
 
 void Simulation::step() {
+  using clock = std::chrono::steady_clock;
+  auto mark = clock::now();
+  auto lap = [&](double& phase) {
+    const auto now = clock::now();
+    phase += std::chrono::duration<double>(now - mark).count();
+    mark = now;
+  };
   dt_s_ = next_dt_s();
   arena_->execute([&] {
     clear_grid();
     sort_particles();
+    lap(phase_s_.sort);
     (this->*p2g_)();
+    lap(phase_s_.p2g);
     grid_update();
+    lap(phase_s_.grid);
     bodies_and_walls();
+    lap(phase_s_.contact);
     (this->*g2p_)();
+    lap(phase_s_.g2p);
     (this->*constitutive_)();
+    lap(phase_s_.constitutive);
   });
   advance_bodies();
   t_s_ += dt_s_;
   ++steps_;
-  if (steps_ % 16 == 0) arena_->execute([&] { reorder_particles(); });
+  if (steps_ % 16 == 0) {
+    arena_->execute([&] { reorder_particles(); });
+    lap(phase_s_.reorder);
+  }
 }
 
 bool Simulation::finished() const {

@@ -63,6 +63,13 @@ struct StepStats {
   bool contact_converged = true;      // the solve met its tolerance within its sweep limit
 };
 
+// Wall-clock seconds spent in each phase of step(), summed over the run (for profiles: where a
+// step's time goes; they never feed back into the results).
+struct PhaseSeconds {
+  double sort = 0, p2g = 0, grid = 0, contact = 0, g2p = 0, constitutive = 0, reorder = 0;
+  double total() const { return sort + p2g + grid + contact + g2p + constitutive + reorder; }
+};
+
 // A material point near a body's surface and its contact impulses (particle contact).
 struct ContactPoint {
   size_t base;            // grid index of the first node of the point's stencil
@@ -100,6 +107,7 @@ class Simulation {
   double last_dt_s() const { return dt_s_; }
   double next_dt_s() const;
   const StepStats& stats() const { return stats_; }
+  const PhaseSeconds& phase_seconds() const { return phase_s_; }
   double wave_speed_m_s() const { return wave_speed_; }
   // distance travelled by the first moving body (m), for end_displacement and averaging windows
   double lead_body_travel_m() const;
@@ -140,6 +148,7 @@ class Simulation {
   double t_s_ = 0.0, dt_s_ = 0.0, wave_speed_ = 0.0;
   int64_t steps_ = 0;
   StepStats stats_;
+  PhaseSeconds phase_s_;
   Vec2 gravity_{0, 0};
   bool dilatancy_ = false;
   bool flip_ = false;

@@ -270,3 +270,18 @@ TEST(RateDependence, DpmAddsTheRatePartToTheStateFriction) {
   EXPECT_NEAR(s.phi_d, p.phi_c, 1e-12);
   EXPECT_NEAR(tau_of(s) / s.pressure_Pa, mu_of_I(p, p.friction(s.phi_d), I), 0.02 * mu_of_I(p, 0.38, I));
 }
+
+// The pressure's log of phi / phi_d: the series used near 1 agrees with the library log to round-off
+// (a few units in the last place) on both sides of 1 and at the switch to std::log.
+TEST(LogNearOne, MatchesTheLibraryLogToRoundOff) {
+  double worst = 0.0;
+  for (double x = 1e-14; x < 2e-3; x *= 1.01)
+    for (double q : {1.0 + x, 1.0 - x}) {
+      const double ref = std::log(q), got = log_near_one(q);
+      worst = std::max(worst, std::abs(got - ref) / std::abs(ref));
+    }
+  std::printf("largest relative difference from std::log: %.2g\n", worst);
+  EXPECT_LT(worst, 4.0 * std::numeric_limits<double>::epsilon());
+  EXPECT_EQ(log_near_one(1.0), 0.0);
+  EXPECT_DOUBLE_EQ(log_near_one(0.5), std::log(0.5));
+}
