@@ -258,3 +258,58 @@ TEST(FrameRenderer, RangeAccumulatorUsesActiveCellsAndLogFloor) {
   EXPECT_EQ(colorbar_title("packing_fraction", false), "Packing fraction");
   EXPECT_EQ(colorbar_title("velocity", false), "Velocity magnitude (m/s)");
 }
+
+TEST(FrameRenderer, ColorbarTicksSitAtRoundValuesInKilopascal) {
+  // 0..2967 Pa: ticks every 0.5 kPa, each where the bar shows that value's colour, text under each
+  FrameStyle style;
+  style.field = "pressure";
+  style.range = {0.0, max_pressure(), false};
+  FrameRenderer r(style);
+  const RgbImage img = r.render(test_frame());
+  dump(img, "colorbar_ticks");
+  const FrameLayout& L = r.layout();
+  EXPECT_EQ(L.colorbar_unit, "kPa");
+  std::vector<std::string> labels;
+  for (const auto& t : L.colorbar_ticks) labels.push_back(t.label);
+  EXPECT_EQ(labels, (std::vector<std::string>{"0", "0.5", "1.0", "1.5", "2.0", "2.5"}));
+  const Colormap& cmap = load_colormap("viridis");
+  const int y_bar = (L.colorbar_bar_y0 + L.colorbar_bar_y1) / 2;
+  for (const auto& t : L.colorbar_ticks) {
+    const int x = std::clamp(int(std::lround(t.x_px)), L.colorbar_x0 + 1, L.colorbar_x1 - 2);
+    double dist = 0;
+    const int idx = cmap.nearest_index(img.at(x, y_bar), &dist);
+    EXPECT_LE(dist, 3.0) << t.label;
+    EXPECT_NEAR(idx, std::min(255.0, 256.0 * t.value / max_pressure()), 2.0) << t.label;
+    // a dark tick mark just under the bar and label text centred under it
+    int dark = 0;
+    for (int y = L.colorbar_bar_y1; y < L.colorbar_y1; ++y)
+      for (int xx = x - 12; xx <= x + 12; ++xx) dark += img.at(xx, y)[0] < 90 && img.at(xx, y)[2] < 90;
+    EXPECT_GT(dark, 15) << t.label;
+  }
+  // between two ticks, under the bar: no text
+  const int gap_x = int(0.5 * (L.colorbar_ticks[1].x_px + L.colorbar_ticks[2].x_px));
+  int dark_gap = 0;
+  for (int y = L.colorbar_bar_y1; y < L.colorbar_y1; ++y)
+    for (int x = gap_x - 10; x <= gap_x + 10; ++x) dark_gap += img.at(x, y)[0] < 90 && img.at(x, y)[2] < 90;
+  EXPECT_EQ(dark_gap, 0);
+  // the title reads in the labels' unit
+  EXPECT_EQ(colorbar_title("pressure", false, L.colorbar_unit), "Pressure (kPa)");
+}
+
+TEST(FrameRenderer, LogColorbarHasDecadeTicks) {
+  FrameStyle style;
+  style.field = "strain_rate";
+  style.range = {1e-3, 10.0, true};
+  FrameRenderer r(style);
+  r.render(test_frame());
+  const FrameLayout& L = r.layout();
+  ASSERT_EQ(L.colorbar_ticks.size(), 5u);
+  const double bar_w = L.colorbar_x1 - L.colorbar_x0;
+  for (size_t k = 0; k < 5; ++k) {
+    EXPECT_NEAR(L.colorbar_ticks[k].value, std::pow(10.0, double(k) - 3.0), 1e-12);
+    EXPECT_NEAR(L.colorbar_ticks[k].x_px, L.colorbar_x0 + bar_w * double(k) / 4.0, 1e-6);  // evenly spaced
+  }
+  EXPECT_EQ(L.colorbar_ticks[0].label, "0.001");
+  EXPECT_EQ(L.colorbar_ticks[4].label, "10");
+  EXPECT_EQ(L.colorbar_unit, "1/s");
+}
