@@ -157,6 +157,7 @@ int render_main(const Parsed& p) {
 
   render::FrameStyle style;
   style.field = fields.front();
+  style.smooth = p.has("--smooth");
   if (p.has("--colormap")) {
     style.colormap = p.get("--colormap");
     render::load_colormap(style.colormap);  // unknown name: error listing the known ones
@@ -317,7 +318,8 @@ Command command_render() {
           "The colour range is fixed over all selected frames (min..max over cells with material; strain\n"
           "rate on a log scale from max/10^4 up to its max) unless --range is given. Cells without material\n"
           "are grey, bodies are outlined in cyan, and each image carries a colorbar with the field's unit and\n"
-          "the time stamp. Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
+          "the time stamp. Each cell is one flat colour unless --smooth blends the values between cell\n"
+          "centres within the material (cells without material stay grey, so the free surface stays sharp). Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
           "for each body, the resisting force -F.d (d = unit direction of its travel from first to last\n"
           "position; Fy for a plate pushed down) against its displacement from its first position.\n"
           "\n"
@@ -343,7 +345,8 @@ Command command_render() {
            {"--range", true, false, "fixed colour range instead of the frames' min..max (one field only)", "LO:HI"},
            {"--colormap", true, false, "viridis, magma or coolwarm (default: by field; one field only)", "NAME"},
            {"--fps", true, false, "movie frames per second (default 10)", "N"},
-           {"--no-panel", false, false, "leave out the force panel"}},
+           {"--no-panel", false, false, "leave out the force panel"},
+           {"--smooth", false, false, "blend values between cell centres within the material (display only)"}},
           1,
           1,
           render_main};

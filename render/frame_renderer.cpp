@@ -44,6 +44,7 @@
 
 #include "render/colormap.hpp"
 #include "render/gl_context.hpp"
+#include "render/smooth.hpp"
 #include "render/ticks.hpp"
 
 namespace furrow::render {
@@ -515,8 +516,9 @@ RgbImage FrameRenderer::render(const FieldFrame& frame) {
   layout_.bed_y0 = top_band + 0.5 * (avail_h - bed_h * ppm);
   layout_.bed_y1 = layout_.bed_y0 + bed_h * ppm;
   layout_.bed_origin_m = frame.origin_m;
-  // field texture: one image point per cell, at the cell centre
-  const int sub = 1;
+  // field texture: one image point per cell (or per sub-cell when smoothed), at its centre
+  const int sub = style_.smooth ? std::clamp(int(std::ceil(ppm * frame.dx_m / 2.0)), 2, 8) : 1;  // ~2 px each
+  if (sub > 1) v = upsample_within_material(v, frame.nx, frame.ny, sub, style_.range.log);
   const double h = frame.dx_m / sub;
   p.image->SetDimensions(frame.nx * sub, frame.ny * sub, 1);
   p.image->SetSpacing(h, h, 1.0);

@@ -78,6 +78,9 @@ struct FrameStyle {
   int time_decimals = 3;
   double font_scale = 0.0;  // text size relative to a 720-pixel-high image; 0: height / 720
   std::optional<ForcePanel> panel;  // side panel (right ~38% of the image)
+  // Display only: blend values between cell centres inside the material on a finer image
+  // (render/smooth.hpp); cells without material stay empty, so the free surface stays sharp.
+  bool smooth = false;
   std::array<float, 3> empty_rgb{0.82f, 0.82f, 0.82f};     // cells with no material
   std::array<float, 3> outline_rgb{0.0f, 0.9f, 1.0f};      // body outlines (cyan: in no colormap)
   std::array<float, 3> background_rgb{1.0f, 1.0f, 1.0f};

@@ -1,11 +1,13 @@
 // FrameRenderer on synthetic frames with known fields (DISPLAY unset). Set FURROW_TEST_DUMP=DIR
 // to keep the rendered images for a look.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
+#include "engine/field_store.hpp"
 #include "render/colormap.hpp"
 #include "render/frame_renderer.hpp"
 #include "tests/render/capture_output.hpp"
@@ -312,4 +314,87 @@ TEST(FrameRenderer, LogColorbarHasDecadeTicks) {
   EXPECT_EQ(L.colorbar_ticks[0].label, "0.001");
   EXPECT_EQ(L.colorbar_ticks[4].label, "10");
   EXPECT_EQ(L.colorbar_unit, "1/s");
+}
+
+TEST(FrameRenderer, SmoothDisplayStaysInsideTheMaterialAndRemovesTheStaircase) {
+  // a stored frame in coarse 1 cm cells whose free surface slopes: material only below it
+  FieldFrame f = test::hydrostatic_frame(40, 25, 0.01, 0.2);
+  for (int j = 0; j < f.ny; ++j)
+    for (int i = 0; i < f.nx; ++i)
+      if ((j + 0.5) * 0.01 > 0.1 + 0.25 * (i + 0.5) * 0.01) {
+        f.active[f.index(i, j)] = 0;
+        f.scalars["pressure"][f.index(i, j)] = 0.f;
+      }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("furrow_smooth_" + std::to_string(::getpid()) + ".vdb")).string();
+  write_frame_vdb(path, f);
+  const FieldFrame stored = read_frame(path);
+  std::filesystem::remove(path);
+  const std::vector<float> stored_pressure = stored.scalars.at("pressure");
+
+  FrameStyle style;
+  style.field = "pressure";
+  style.width = 960, style.height = 540;
+  style.range = {0.0, max_pressure(), false};
+  FrameRenderer flat_r(style);
+  style.smooth = true;
+  FrameRenderer smooth_r(style);
+  const RgbImage flat = flat_r.render(stored), smooth = smooth_r.render(stored);
+  dump(smooth, "smooth");
+  EXPECT_EQ(stored.scalars.at("pressure"), stored_pressure);  // display only
+  const FrameLayout& L = smooth_r.layout();
+  const double cell_px = L.px_per_m * 0.01;
+  ASSERT_GT(cell_px, 8.0);
+  const Colormap& cmap = load_colormap("viridis");
+  // the cell under a pixel centre; `margin`: whether it lies 1.5 px clear of the cell's edges
+  auto cell_of = [&](int x, int y, bool* clear) -> long {
+    const double cx = (x + 0.5 - L.bed_x0) / cell_px, cy = (L.bed_y1 - y - 0.5) / cell_px;
+    if (cx <= 0 || cy <= 0 || cx >= f.nx || cy >= f.ny) return -1;
+    const double m = 1.5 / cell_px;
+    *clear = cx - std::floor(cx) > m && std::ceil(cx) - cx > m && cy - std::floor(cy) > m && std::ceil(cy) - cy > m;
+    return long(stored.index(int(cx), int(cy)));
+  };
+  // a cell whose 8 neighbours all hold material (away from the free surface)
+  auto deep_inside = [&](long c) {
+    const int i = int(c % f.nx), j = int(c / f.nx);
+    for (int b = -1; b <= 1; ++b)
+      for (int a = -1; a <= 1; ++a) {
+        const int ii = std::clamp(i + a, 0, f.nx - 1), jj = std::clamp(j + b, 0, f.ny - 1);
+        if (!stored.active[stored.index(ii, jj)]) return false;
+      }
+    return true;
+  };
+  int outside_material = 0, empty_checked = 0, material_checked = 0, pairs = 0;
+  double sq_flat = 0, sq_smooth = 0;
+  for (int y = int(L.bed_y0); y + 1 < int(L.bed_y1); ++y)
+    for (int x = int(L.bed_x0); x < int(L.bed_x1); ++x) {
+      bool clear = false, unused = false;
+      const long c = cell_of(x, y, &clear);
+      if (c < 0) continue;
+      if (clear && !stored.active[size_t(c)]) {
+        ++empty_checked;
+        outside_material += !near_rgb(smooth.at(x, y), style.empty_rgb, 1);
+      }
+      if (clear && stored.active[size_t(c)]) {
+        ++material_checked;
+        double d = 0;
+        cmap.nearest_index(smooth.at(x, y), &d);
+        EXPECT_LE(d, 3.0) << "not a colormap colour at (" << x << ", " << y << ")";
+      }
+      // vertical neighbours inside the material, across cell edges too (the field varies with depth)
+      const long below = cell_of(x, y + 1, &unused);
+      if (below < 0 || !deep_inside(c) || !deep_inside(below)) continue;
+      const int s0 = cmap.nearest_index(smooth.at(x, y)), s1 = cmap.nearest_index(smooth.at(x, y + 1));
+      const int f0 = cmap.nearest_index(flat.at(x, y)), f1 = cmap.nearest_index(flat.at(x, y + 1));
+      sq_smooth += double(s1 - s0) * (s1 - s0);
+      sq_flat += double(f1 - f0) * (f1 - f0);
+      ++pairs;
+    }
+  EXPECT_GT(empty_checked, 10000);
+  EXPECT_GT(material_checked, 20000);
+  EXPECT_GT(pairs, 20000);
+  EXPECT_EQ(outside_material, 0) << "smoothed colour outside the material mask";
+  // per-cell colours jump ~13 indices at each cell row and not between; the blend ~1 per pixel
+  // row: the mean squared jump drops by about the pixels per cell
+  EXPECT_GT(sq_flat, 4.0 * sq_smooth) << "mean squared jump, flat " << sq_flat / pairs << ", smooth " << sq_smooth / pairs;
 }
