@@ -6,6 +6,7 @@
 
 #include "app/commands.hpp"
 #include "render/inspector.hpp"
+#include "render/inspector_window.hpp"
 
 namespace fs = std::filesystem;
 
@@ -19,32 +20,36 @@ int inspect_main(const Parsed& p) {
     std::cerr << "furrow inspect: run directory '" << run_dir << "' does not exist\n";
     return 1;
   }
-  if (!p.has("--headless")) {
-    const char* display = std::getenv("DISPLAY");
-    std::cerr << "furrow inspect: the interactive window is not built yet"
-              << (display && *display ? "" : " (and there is no DISPLAY)")
-              << "; use --headless --script FILE\n";
+  const bool headless = p.has("--headless");
+  if (headless && !p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
+  if (!headless && !render::inspector_window_available()) {
+    std::cerr << "furrow inspect: this furrow was built without GLFW/X11 and has no window; use --headless --script FILE\n";
     return 2;
   }
-  if (!p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
+  const char* display = std::getenv("DISPLAY");
+  if (!headless && !(display && *display)) {
+    std::cerr << "furrow inspect: no display (DISPLAY is not set) for the window; use --headless --script FILE\n";
+    return 2;
+  }
+  if (p.has("--exit-after-script") && (headless || !p.has("--script")))
+    throw UsageError("--exit-after-script is for a --script replayed in the window (without --headless)");
   int width = 1280, height = 720;
   if (p.has("--size")) {
-    const std::string s = p.get("--size");
-    const size_t x = s.find('x');
-    char* end1 = nullptr;
-    char* end2 = nullptr;
-    const long w = x == std::string::npos ? 0 : std::strtol(s.substr(0, x).c_str(), &end1, 10);
-    const long h = x == std::string::npos ? 0 : std::strtol(s.substr(x + 1).c_str(), &end2, 10);
-    if (x == std::string::npos || *end1 || *end2 || w < 400 || h < 300 || w > 8192 || h > 8192)
-      throw UsageError("--size: expected WxH with W in 400..8192 and H in 300..8192, got '" + s + "'");
-    width = int(w), height = int(h);
+    parse_size(p.get("--size"), &width, &height);
+    if (width < 400 || height < 300) throw UsageError("--size: the inspector needs at least 400x300, got '" + p.get("--size") + "'");
   }
   // the whole script is checked before anything runs
   const std::string script = p.get("--script");
-  const std::vector<render::ScriptStep> steps = render::parse_inspect_script(script);
+  const std::vector<render::ScriptStep> steps = script.empty() ? std::vector<render::ScriptStep>{}
+                                                               : render::parse_inspect_script(script);
 
   render::InspectorState state = render::open_run(run_dir, p.get("--field"));
   render::InspectorView view(width, height, p.has("--smooth"));
+  if (!headless) {
+    render::WindowOptions w;
+    w.script = steps, w.script_path = script, w.exit_after_script = p.has("--exit-after-script");
+    return render::run_inspector_window(state, view, w, std::cout, std::cerr);
+  }
   for (const auto& step : steps) {
     nlohmann::json r;
     try {
@@ -63,17 +68,22 @@ int inspect_main(const Parsed& p) {
 
 Command command_inspect() {
   return {"inspect",
-          "inspect a stored run: probe, profile, measure, screenshot (headless script)",
-          "furrow inspect RUN_DIR --headless --script FILE [--field NAME] [--size WxH] [--smooth]",
-          std::string("Opens the frames stored in RUN_DIR (frames/*.vdb, forces.csv) and replays the actions of\n"
-                      "FILE against an off-screen view, printing one JSON object per action on stdout (SI units;\n"
-                      "every object has \"action\" and the script \"line\"; a value where there is no material is\n"
-                      "null). The whole script is checked first: a bad line is an error naming FILE, the line and\n"
+          "inspect a stored run in a window, or replay a script headless: probe, profile, measure, screenshot",
+          "furrow inspect RUN_DIR [--headless] [--script FILE [--exit-after-script]] [--field NAME] [--size WxH] [--smooth]",
+          std::string("Opens the frames stored in RUN_DIR (frames/*.vdb, forces.csv). In a window (a display is\n"
+                      "needed): the frame and the inspector panel; pick the field and frame in the panel, click\n"
+                      "on the bed to probe, Left/Right for the previous/next frame, S for a screenshot\n"
+                      "(inspect.png, inspect_2.png, ...), Esc or Q to quit; a --script is replayed there first and\n"
+                      "its screenshots are read back from the window. With --headless, replays the actions of\n"
+                      "FILE against an off-screen view. Either way each result is one JSON object on stdout (SI units;\n"
+                      "every object has \"action\", a script's also its \"line\"; a value where there is no\n"
+                      "material is null). The whole script is checked first: a bad line is an error naming FILE, the line and\n"
                       "what was expected, and nothing runs. Colour ranges are fixed over the run, as in movies.\n"
                       "A screenshot never replaces an existing file.\n\n") +
               render::kInspectScriptHelp,
           {{"--headless", false, false, "no window: replay --script off-screen"},
            {"--script", true, false, "the actions to replay, one per line", "FILE"},
+           {"--exit-after-script", false, false, "close the window once the script has run"},
            {"--field", true, false, "field selected at the start (default: strain_rate, else pressure, ...)", "NAME"},
            {"--size", true, false, "screenshot size (default 1280x720; the panel takes a third, up to 420 px)", "WxH"},
            {"--smooth", false, false, "draw fields smoothed within the material (display only)"}},

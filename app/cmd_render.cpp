@@ -36,14 +36,6 @@ long long parse_int(const std::string& s, const std::string& option) {
   return v;
 }
 
-void parse_size(const std::string& s, int* w, int* h) {
-  const size_t x = s.find('x');
-  if (x == std::string::npos) throw UsageError("--size: expected WxH, e.g. 1280x720, got '" + s + "'");
-  const long long ww = parse_int(s.substr(0, x), "--size"), hh = parse_int(s.substr(x + 1), "--size");
-  if (ww < 16 || hh < 16 || ww > 8192 || hh > 8192)
-    throw UsageError("--size: width and height must be in 16..8192, got '" + s + "'");
-  *w = int(ww), *h = int(hh);
-}
 
 // "a,b,,c" -> {"a", "b", "", "c"}: every field, empty ones too
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -306,6 +298,15 @@ int demo_main(const Parsed& p) {
 }
 
 }  // namespace
+
+void parse_size(const std::string& s, int* w, int* h) {
+  const size_t x = s.find('x');
+  if (x == std::string::npos) throw UsageError("--size: expected WxH, e.g. 1280x720, got '" + s + "'");
+  const long long ww = parse_int(s.substr(0, x), "--size"), hh = parse_int(s.substr(x + 1), "--size");
+  if (ww < 16 || hh < 16 || ww > 8192 || hh > 8192)
+    throw UsageError("--size: width and height must be in 16..8192, got '" + s + "'");
+  *w = int(ww), *h = int(hh);
+}
 
 Command command_render() {
   return {"render",

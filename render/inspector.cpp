@@ -1,6 +1,7 @@
 #include "render/inspector.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -288,6 +289,14 @@ std::string short_number(double v) {
 }
 }  // namespace
 
+nlohmann::json write_screenshot(const InspectorState& s, const std::string& path, const RgbImage& img, int panel_x0) {
+  write_png(img, path, false);
+  nlohmann::json r = {{"action", "screenshot"}, {"path", path}, {"width", img.width}, {"height", img.height},
+                      {"panel_x0", panel_x0}, {"field", s.field}};
+  r.update(where(s));
+  return r;
+}
+
 nlohmann::json apply_action(InspectorState& s, const InspectAction& action, InspectorView* view) {
   nlohmann::json r;
   if (auto* a = std::get_if<SelectField>(&action)) {
@@ -325,12 +334,7 @@ nlohmann::json apply_action(InspectorState& s, const InspectAction& action, Insp
     s.notes.push_back("length " + short_number(r["m"].get<double>()) + " m");
   } else if (auto* a = std::get_if<Screenshot>(&action)) {
     if (!view) throw std::logic_error("screenshot needs an InspectorView");
-    const RgbImage img = view->render(s);
-    write_png(img, a->path, false);
-    r = {{"action", "screenshot"}, {"path", a->path}, {"width", img.width}, {"height", img.height},
-         {"panel_x0", view->panel_x0()}};
-    r.update(where(s));
-    r["field"] = s.field;
+    r = write_screenshot(s, a->path, view->render(s), view->panel_x0());
   }
   if (s.notes.size() > 8) s.notes.erase(s.notes.begin(), s.notes.end() - 8);
   return r;
@@ -427,7 +431,7 @@ const FrameLayout& InspectorView::frame_layout() const {
   return frame_->layout();
 }
 
-RgbImage InspectorView::render(const InspectorState& s) {
+RgbImage InspectorView::render(const InspectorState& s, const ViewInput* input, std::vector<InspectAction>* changes) {
   if (!frame_ || renderer_field_ != s.field) {
     FrameStyle style;
     style.field = s.field;
@@ -437,13 +441,32 @@ RgbImage InspectorView::render(const InspectorState& s) {
     style.time_decimals = time_decimals_for(s.times_s);
     frame_ = std::make_unique<FrameRenderer>(style);
     renderer_field_ = s.field;
+    drawn_path_.clear();
+  }
+  if (drawn_path_ != s.frame_paths[s.current] || drawn_field_ != s.field) {
+    field_image_ = frame_->render(s.frame);
+    drawn_path_ = s.frame_paths[s.current], drawn_field_ = s.field;
   }
   RgbImage out(width_, height_);
-  out.blit(frame_->render(s.frame), 0, 0);
-  if (!ui_) ui_ = std::make_unique<ImGuiOffscreen>(panel_w_, height_);
+  out.blit(field_image_, 0, 0);
+  const bool first = !ui_;
+  if (first) ui_ = std::make_unique<ImGuiOffscreen>(panel_w_, height_);
   const float clear[3] = {1.0f, 1.0f, 1.0f};
-  auto draw = [&] { draw_inspector_panel(s, 0.0f, float(panel_w_), float(height_)); };
-  ui_->frame(draw, clear);  // the first frame lays the windows out
+  auto draw = [&] {
+    std::vector<InspectAction> c = draw_inspector_panel(s, 0.0f, float(panel_w_), float(height_));
+    if (changes) changes->insert(changes->end(), c.begin(), c.end());
+  };
+  if (first) ui_->frame(draw, clear);  // the first frame lays the windows out
+  if (input) {
+    ImGuiContext* previous = ImGui::GetCurrentContext();
+    ImGui::SetCurrentContext(ui_->context());
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = input->mouse_x >= panel_x0() ? ImVec2(input->mouse_x - float(panel_x0()), input->mouse_y)
+                                               : ImVec2(-FLT_MAX, -FLT_MAX);
+    for (int b = 0; b < 3; ++b) io.MouseDown[b] = input->mouse_down[b] && input->mouse_x >= panel_x0();
+    io.MouseWheel = input->wheel;
+    ImGui::SetCurrentContext(previous);
+  }
   out.blit(ui_->frame(draw, clear), panel_x0(), 0);
   return out;
 }

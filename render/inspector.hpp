@@ -79,8 +79,17 @@ class InspectorView;
 // where there is no material is null). Throws std::runtime_error for what the run cannot do
 // (a frame or field it has not stored). Screenshot needs a view.
 nlohmann::json apply_action(InspectorState& s, const InspectAction& a, InspectorView* view);
+// Writes a screenshot (never over an existing file) and returns its result line.
+nlohmann::json write_screenshot(const InspectorState& s, const std::string& path, const RgbImage& img, int panel_x0);
 
 // ---- view ---------------------------------------------------------------------------------------
+// The mouse over the view (pixels from its top-left corner), for a window; none off-screen.
+struct ViewInput {
+  float mouse_x = -1, mouse_y = -1;
+  bool mouse_down[3] = {false, false, false};
+  float wheel = 0;
+};
+
 // The frame drawn by a FrameRenderer (colorbar, time, outlines; no VTK force plot) on the left and
 // the ImGui panel (field and frame pickers, force against displacement with the current frame
 // marked, last results) on the right, off-screen.
@@ -91,7 +100,11 @@ class InspectorView {
   InspectorView(const InspectorView&) = delete;
   InspectorView& operator=(const InspectorView&) = delete;
 
-  RgbImage render(const InspectorState& s);
+  // With `input`, the panel sees the mouse and `changes` receives what the user picked.
+  RgbImage render(const InspectorState& s, const ViewInput* input = nullptr,
+                  std::vector<InspectAction>* changes = nullptr);
+  int width() const { return width_; }
+  int height() const { return height_; }
   int panel_x0() const { return width_ - panel_w_; }  // the ImGui panel's left edge
   const FrameLayout& frame_layout() const;
 
@@ -101,6 +114,10 @@ class InspectorView {
   std::string renderer_field_;
   std::unique_ptr<FrameRenderer> frame_;
   std::unique_ptr<class ImGuiOffscreen> ui_;
+  // the last field image and what it showed: redrawn only when the frame or field changes
+  RgbImage field_image_;
+  std::string drawn_field_;
+  std::string drawn_path_;
 };
 
 // Draws the inspector panel as ImGui calls inside the current frame (window at x0, full height,

@@ -5,7 +5,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <chrono>
 #include <sstream>
+#include <thread>
 
 #include "engine/field_store.hpp"
 #include "render/colormap.hpp"
@@ -161,6 +166,76 @@ TEST_F(InspectCli, BadScriptLinesNameFileLineAndWhatWasExpected) {
   r = run({"inspect", (dir_ / "run").string()});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--headless --script FILE"), std::string::npos) << r.err;
+}
+
+// A virtual X display for the window test: Xvfb on a display number of this process's own.
+struct Xvfb {
+  pid_t pid = -1;
+  int number = 0;
+  bool up = false;
+  Xvfb() {
+    number = 200 + int(::getpid() % 500);
+    pid = fork();
+    if (pid == 0) {
+      const std::string d = ":" + std::to_string(number);
+      freopen("/dev/null", "w", stderr);
+      execlp("Xvfb", "Xvfb", d.c_str(), "-screen", "0", "1600x900x24", "-nolisten", "tcp", (char*)nullptr);
+      _exit(127);
+    }
+    const std::string socket = "/tmp/.X11-unix/X" + std::to_string(number);
+    for (int k = 0; k < 100 && pid > 0 && !up; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      up = std::filesystem::exists(socket) && waitpid(pid, nullptr, WNOHANG) == 0;
+    }
+  }
+  ~Xvfb() {
+    if (pid > 0) {
+      kill(pid, SIGTERM);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+TEST_F(InspectCli, WindowUnderXvfbReplaysAScriptAndScreenshotsTheWindow) {
+  if (std::system("command -v Xvfb >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "Xvfb is not installed (apt-get install xvfb, as .ci/setup.sh does): no display to open the window on";
+  Xvfb x;
+  if (!x.up) GTEST_SKIP() << "Xvfb could not start on display :" << x.number;
+  const StoredRun stored(dir_ / "run");
+  const std::string shot = path("window.png");
+  setenv("DISPLAY", (":" + std::to_string(x.number)).c_str(), 1);
+  const auto r = run({"inspect", (dir_ / "run").string(), "--script",
+                      script("frame 1\nfield strain_rate\nscreenshot " + shot + "\n"), "--exit-after-script"});
+  unsetenv("DISPLAY");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<json> out = lines(r.out);
+  ASSERT_EQ(out.size(), 3u) << r.out;
+  EXPECT_EQ(out[2]["action"], "screenshot");
+  EXPECT_EQ(out[2]["frame"], 1);
+  // read back from the X server: the strain-rate field on the left, the panel on the right
+  const auto img = furrow::render::read_png(shot);
+  ASSERT_EQ(img.width, 1280);
+  ASSERT_EQ(img.height, 720);
+  const int x0 = out[2]["panel_x0"].get<int>();
+  int dark = 0, bright = 0, panel = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = x0; x < img.width; ++x) {
+      const uint8_t* p = img.at(x, y);
+      ++panel;
+      dark += p[0] < 120 && p[1] < 120 && p[2] < 120;
+      bright += p[0] > 180 && p[1] > 180 && p[2] > 180 && x > x0 + 4 && y > 24;
+    }
+  EXPECT_GT(dark, panel / 2);
+  EXPECT_GT(bright, 500);
+  const auto& magma = furrow::render::load_colormap("magma");
+  int field_px = 0;
+  for (int y = 0; y < img.height; y += 2)
+    for (int x = 0; x < x0; x += 2) {
+      double d = 0;
+      magma.nearest_index(img.at(x, y), &d);
+      field_px += d < 2.0;
+    }
+  EXPECT_GT(field_px, 10000);
 }
 
 }  // namespace
