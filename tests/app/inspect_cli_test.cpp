@@ -23,6 +23,30 @@ namespace {
 using furrow::cli_test::StoredRun;
 using nlohmann::json;
 
+// A screenshot of the view: the field in `colormap` colours left of x0 and the ImGui panel (a dark
+// window with light text and the plot) from x0 on.
+void expect_inspector_view(const furrow::render::RgbImage& img, int x0, const std::string& colormap) {
+  int dark = 0, bright = 0, panel = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = x0; x < img.width; ++x) {
+      const uint8_t* p = img.at(x, y);
+      ++panel;
+      dark += p[0] < 120 && p[1] < 120 && p[2] < 120;
+      bright += p[0] > 180 && p[1] > 180 && p[2] > 180 && x > x0 + 4 && y > 24;  // text on the dark window
+    }
+  EXPECT_GT(dark, panel / 2) << "the panel's dark window fills its region";
+  EXPECT_GT(bright, 500) << "text and the plot in the panel";
+  const auto& cmap = furrow::render::load_colormap(colormap);
+  int field_px = 0;
+  for (int y = 0; y < img.height; y += 2)
+    for (int x = 0; x < x0; x += 2) {
+      double d = 0;
+      cmap.nearest_index(img.at(x, y), &d);
+      field_px += d < 2.0;
+    }
+  EXPECT_GT(field_px, 10000) << "the field in " << colormap << " colours";
+}
+
 class InspectCli : public furrow::cli_test::CliFixture {
  protected:
   InspectCli() : CliFixture("furrow_inspect_cli_") {}
@@ -115,25 +139,7 @@ TEST_F(InspectCli, ScriptedSessionProbesProfilesMeasuresAndScreenshots) {
   ASSERT_EQ(img.height, 720);
   const int x0 = s["panel_x0"].get<int>();
   EXPECT_EQ(x0, 860);
-  int non_white = 0, bright = 0, panel = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = x0; x < img.width; ++x) {
-      const uint8_t* p = img.at(x, y);
-      ++panel;
-      non_white += p[0] < 200 || p[1] < 200 || p[2] < 200;
-      bright += p[0] > 180 && p[1] > 180 && p[2] > 180 && x > x0 + 4 && y > 24;  // text on the dark window
-    }
-  EXPECT_GT(non_white, panel * 8 / 10) << "the panel's dark window fills its region";
-  EXPECT_GT(bright, 500) << "text and the plot in the panel";
-  const auto& viridis = furrow::render::load_colormap("viridis");
-  int field_px = 0;
-  for (int y = 0; y < img.height; y += 2)
-    for (int x = 0; x < x0; x += 2) {
-      double d = 0;
-      viridis.nearest_index(img.at(x, y), &d);
-      field_px += d < 2.0;
-    }
-  EXPECT_GT(field_px, 10000);
+  expect_inspector_view(img, x0, "viridis");
   // the same screenshot again is refused: nothing is overwritten
   const auto again = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("screenshot " + shot + "\n")});
   EXPECT_EQ(again.status, 1);
@@ -217,25 +223,7 @@ TEST_F(InspectCli, WindowUnderXvfbReplaysAScriptAndScreenshotsTheWindow) {
   ASSERT_EQ(img.width, 1280);
   ASSERT_EQ(img.height, 720);
   const int x0 = out[2]["panel_x0"].get<int>();
-  int dark = 0, bright = 0, panel = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = x0; x < img.width; ++x) {
-      const uint8_t* p = img.at(x, y);
-      ++panel;
-      dark += p[0] < 120 && p[1] < 120 && p[2] < 120;
-      bright += p[0] > 180 && p[1] > 180 && p[2] > 180 && x > x0 + 4 && y > 24;
-    }
-  EXPECT_GT(dark, panel / 2);
-  EXPECT_GT(bright, 500);
-  const auto& magma = furrow::render::load_colormap("magma");
-  int field_px = 0;
-  for (int y = 0; y < img.height; y += 2)
-    for (int x = 0; x < x0; x += 2) {
-      double d = 0;
-      magma.nearest_index(img.at(x, y), &d);
-      field_px += d < 2.0;
-    }
-  EXPECT_GT(field_px, 10000);
+  expect_inspector_view(img, x0, "magma");
 }
 
 }  // namespace
