@@ -36,14 +36,6 @@ long long parse_int(const std::string& s, const std::string& option) {
   return v;
 }
 
-void parse_size(const std::string& s, int* w, int* h) {
-  const size_t x = s.find('x');
-  if (x == std::string::npos) throw UsageError("--size: expected WxH, e.g. 1280x720, got '" + s + "'");
-  const long long ww = parse_int(s.substr(0, x), "--size"), hh = parse_int(s.substr(x + 1), "--size");
-  if (ww < 16 || hh < 16 || ww > 8192 || hh > 8192)
-    throw UsageError("--size: width and height must be in 16..8192, got '" + s + "'");
-  *w = int(ww), *h = int(hh);
-}
 
 // "a,b,,c" -> {"a", "b", "", "c"}: every field, empty ones too
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -115,23 +107,49 @@ std::string choose_output(const Parsed& p, const fs::path& default_path, bool* o
   return *overwrite ? default_path.string() : render::next_free_path(default_path.string());
 }
 
+// --range LO:HI on `range` (keeps its log flag); a log range needs LO > 0.
+void apply_range_option(const std::string& spec, const std::string& field, render::FieldRange* range) {
+  const size_t c = spec.find(':');
+  if (c == std::string::npos) throw UsageError("--range: expected LO:HI, got '" + spec + "'");
+  range->lo = parse_number(spec.substr(0, c), "--range");
+  range->hi = parse_number(spec.substr(c + 1), "--range");
+  if (!(range->hi > range->lo)) throw UsageError("--range: LO must be below HI, got '" + spec + "'");
+  if (range->log && range->lo <= 0) throw UsageError("--range: " + field + " is drawn on a log scale, LO must be > 0");
+}
+
+std::string range_text(const std::string& field, const render::FieldRange& r) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s range %.4g..%.4g %s%s", field.c_str(), r.lo, r.hi, find_field(field)->unit.c_str(),
+                r.log ? " (log)" : "");
+  return buf;
+}
+
 int render_main(const Parsed& p) {
   const std::string run_dir = p.positional[0];
   if (!fs::is_directory(run_dir)) {
     std::cerr << "furrow render: run directory '" << run_dir << "' does not exist\n";
     return 1;
   }
-  if (!p.has("--field")) throw UsageError("--field NAME is required (fields: " + all_fields() + ")");
-  const std::string field = p.get("--field");
-  if (!find_field(field)) {
-    std::cerr << "furrow render: unknown field '" << field << "' (valid fields: " << all_fields() << ")\n";
-    return 2;
+  if (!p.has("--field")) throw UsageError("--field NAME[,NAME...] is required (fields: " + all_fields() + ")");
+  const std::vector<std::string> fields = split(p.get("--field"), ',');
+  for (size_t k = 0; k < fields.size(); ++k) {
+    if (!find_field(fields[k])) {
+      std::cerr << "furrow render: unknown field '" << fields[k] << "' in --field " << p.get("--field")
+                << " (valid fields: " << all_fields() << ")\n";
+      return 2;
+    }
+    for (size_t j = 0; j < k; ++j)
+      if (fields[j] == fields[k]) throw UsageError("--field: '" + fields[k] + "' is listed twice");
   }
+  const bool several = fields.size() > 1;
+  if (several && (p.has("--range") || p.has("--colormap")))
+    throw UsageError("--range and --colormap apply to a single --field");
   if (p.has("--png") && p.has("--contact-sheet")) throw UsageError("--png and --contact-sheet exclude each other");
+  const bool sheet = p.has("--contact-sheet");
 
   render::FrameStyle style;
-  style.field = field;
-  if (p.has("--size")) parse_size(p.get("--size"), &style.width, &style.height);
+  style.field = fields.front();
+  style.smooth = p.has("--smooth");
   if (p.has("--colormap")) {
     style.colormap = p.get("--colormap");
     render::load_colormap(style.colormap);  // unknown name: error listing the known ones
@@ -149,57 +167,64 @@ int render_main(const Parsed& p) {
     std::cerr << "furrow render: no frame_*.vdb files in " << frames_dir.string() << "\n";
     return 1;
   }
-  const bool sheet = p.has("--contact-sheet");
   if (sheet && !p.has("--frames")) frames = spread(frames, 12);
 
-  // one fixed range over the frames drawn
-  const render::FrameScan scan = render::scan_frames(frames, field);
-  style.range = scan.range;
-  style.time_decimals = scan.time_decimals;
-  if (p.has("--range")) {
-    const std::string r = p.get("--range");
-    const size_t c = r.find(':');
-    if (c == std::string::npos) throw UsageError("--range: expected LO:HI, got '" + r + "'");
-    style.range.lo = parse_number(r.substr(0, c), "--range");
-    style.range.hi = parse_number(r.substr(c + 1), "--range");
-    if (!(style.range.hi > style.range.lo)) throw UsageError("--range: LO must be below HI, got '" + r + "'");
-    if (style.range.log && style.range.lo <= 0)
-      throw UsageError("--range: " + field + " is drawn on a log scale, LO must be > 0");
+  // one fixed range per field over the frames drawn
+  const std::vector<render::FrameScan> scans = render::scan_frames(frames, fields);
+  render::PanelsStyle panels_style;
+  std::string ranges;
+  for (size_t k = 0; k < fields.size(); ++k) {
+    render::FrameStyle s = style;
+    s.field = fields[k];
+    s.range = scans[k].range;
+    s.time_decimals = scans[k].time_decimals;
+    if (p.has("--range")) apply_range_option(p.get("--range"), fields[k], &s.range);
+    panels_style.fields.push_back(s);
+    ranges += (ranges.empty() ? "" : "; ") + range_text(fields[k], s.range);
   }
+  style = panels_style.fields.front();
   const fs::path forces = fs::path(run_dir) / "forces.csv";
   if (!p.has("--no-panel") && !sheet && fs::exists(forces)) {
     render::ForcePanel panel = render::read_force_panel(forces.string());
-    if (!panel.series.empty()) style.panel = panel;
+    if (!panel.series.empty()) style.panel = panels_style.forces = panel;
   }
+  // default sizes: 1280x720; a sheet 1920 wide; several fields 640x480 per panel (the force plot
+  // is one more panel), on a sheet 1280x720 per field
+  const int panels = int(fields.size()) + (panels_style.forces ? 1 : 0);
+  if (several) style.width = sheet ? 1280 * int(fields.size()) : 640 * panels, style.height = sheet ? 720 : 480;
+  else if (sheet) style.width = 1920, style.height = 1080;
+  if (p.has("--size")) parse_size(p.get("--size"), &style.width, &style.height);
+  panels_style.width = style.width, panels_style.height = style.height;
 
-  char range_text[128];
-  std::snprintf(range_text, sizeof range_text, "%s range %.4g..%.4g %s%s", field.c_str(), style.range.lo,
-                style.range.hi, find_field(field)->unit.c_str(), style.range.log ? " (log)" : "");
+  std::string name;  // default output name: the fields joined by '-'
+  for (const auto& f : fields) name += (name.empty() ? "" : "-") + f;
   bool overwrite = false;
   if (p.has("--png")) {
-    const std::string dir = choose_output(p, fs::path(run_dir) / "renders" / field, &overwrite);
-    const auto written = render::render_pngs(frames, style, dir, overwrite);
-    std::cout << dir << "  (" << written.size() << " PNG, " << style.width << "x" << style.height << ", "
-              << range_text << ")\n";
+    const std::string dir = choose_output(p, fs::path(run_dir) / "renders" / name, &overwrite);
+    const auto written = several ? render::render_pngs(frames, panels_style, dir, overwrite)
+                                 : render::render_pngs(frames, style, dir, overwrite);
+    std::cout << dir << "  (" << written.size() << " PNG, " << style.width << "x" << style.height << ", " << ranges
+              << ")\n";
   } else if (sheet) {
-    const std::string out = choose_output(p, fs::path(run_dir) / "renders" / (field + "_contact_sheet.png"), &overwrite);
+    const std::string out = choose_output(p, fs::path(run_dir) / "renders" / (name + "_contact_sheet.png"), &overwrite);
     if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
     const int columns = p.has("--columns") ? int(parse_int(p.get("--columns"), "--columns")) : 0;
     if (columns < 0) throw UsageError("--columns must be >= 1");
-    if (!p.has("--size")) style.width = 1920, style.height = 1080;
-    const render::RgbImage img = render::render_contact_sheet(frames, style, columns);
+    const render::RgbImage img = several ? render::render_contact_sheet(frames, panels_style, columns)
+                                         : render::render_contact_sheet(frames, style, columns);
     render::write_png(img, out, overwrite);
-    std::cout << out << "  (" << frames.size() << " frames, " << img.width << "x" << img.height << ", " << range_text
+    std::cout << out << "  (" << frames.size() << " frames, " << img.width << "x" << img.height << ", " << ranges
               << ")\n";
   } else {
     if (style.width % 2 || style.height % 2)
       throw UsageError("--size: movies need even width and height (H.264, yuv420p), got " +
                        std::to_string(style.width) + "x" + std::to_string(style.height));
-    const std::string out = choose_output(p, fs::path(run_dir) / "movies" / (field + ".mp4"), &overwrite);
+    const std::string out = choose_output(p, fs::path(run_dir) / "movies" / (name + ".mp4"), &overwrite);
     if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
-    render::render_movie(frames, style, out, fps, overwrite);
+    if (several) render::render_movie(frames, panels_style, out, fps, overwrite);
+    else render::render_movie(frames, style, out, fps, overwrite);
     std::cout << out << "  (" << frames.size() << " frames at " << fps << " fps, " << style.width << "x"
-              << style.height << ", " << range_text << ")\n";
+              << style.height << ", " << ranges << ")\n";
   }
   return 0;
 }
@@ -274,15 +299,28 @@ int demo_main(const Parsed& p) {
 
 }  // namespace
 
+void parse_size(const std::string& s, int* w, int* h) {
+  const size_t x = s.find('x');
+  if (x == std::string::npos) throw UsageError("--size: expected WxH, e.g. 1280x720, got '" + s + "'");
+  const long long ww = parse_int(s.substr(0, x), "--size"), hh = parse_int(s.substr(x + 1), "--size");
+  if (ww < 16 || hh < 16 || ww > 8192 || hh > 8192)
+    throw UsageError("--size: width and height must be in 16..8192, got '" + s + "'");
+  *w = int(ww), *h = int(hh);
+}
+
 Command command_render() {
   return {"render",
           "re-render stored frames to an MP4, PNGs or a contact sheet",
-          "furrow render RUN_DIR --field NAME [--frames a:b[:step]] [--size WxH] [--png | --contact-sheet] [--out PATH]",
-          "Draws one field of the frames stored in RUN_DIR/frames/*.vdb, off-screen (no display needed).\n"
+          "furrow render RUN_DIR --field NAME[,NAME...] [--frames a:b[:step]] [--size WxH] [--png | --contact-sheet] [--out PATH]",
+          "Draws fields of the frames stored in RUN_DIR/frames/*.vdb, off-screen (no display needed).\n"
+          "Several fields (--field strain_rate,pressure,packing_fraction) are drawn side by side, each\n"
+          "with its own colour range and colorbar (default size 640x480 per panel, the force plot being\n"
+          "one more panel; a contact sheet puts one sheet per field side by side, 1280x720 each).\n"
           "The colour range is fixed over all selected frames (min..max over cells with material; strain\n"
           "rate on a log scale from max/10^4 up to its max) unless --range is given. Cells without material\n"
           "are grey, bodies are outlined in cyan, and each image carries a colorbar with the field's unit and\n"
-          "the time stamp. Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
+          "the time stamp. Each cell is one flat colour unless --smooth blends the values between cell\n"
+          "centres within the material (cells without material stay grey, so the free surface stays sharp). Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
           "for each body, the resisting force -F.d (d = unit direction of its travel from first to last\n"
           "position; Fy for a plate pushed down) against its displacement from its first position.\n"
           "\n"
@@ -290,13 +328,14 @@ Command command_render() {
           "  movie            RUN_DIR/movies/<field>.mp4 (H.264, yuv420p; even sizes)\n"
           "  --png            RUN_DIR/renders/<field>/frame_NNNNN.png, one per frame\n"
           "  --contact-sheet  RUN_DIR/renders/<field>_contact_sheet.png: up to 12 frames spread over the run\n"
+          "                  (<field> is the fields joined by '-' when there are several)\n"
           "                  (or exactly those picked by --frames), each tile labelled with its time (1920 wide)\n"
           "Nothing is overwritten: a default name that is taken becomes <name>_2, _3, ...; a taken --out\n"
           "PATH is an error unless --overwrite is given. Prints the path written.\n"
           "\n"
           "--frames selects by frame number (frame_00042.vdb is 42), both ends included: '10:50',\n"
           "'10:50:5' (every 5th), '20:' (to the end), ':30', or '42' (one frame).",
-          {{"--field", true, false, "field to draw: " + all_fields(), "NAME"},
+          {{"--field", true, false, "field(s) to draw, comma-separated: " + all_fields(), "NAME[,NAME...]"},
            {"--frames", true, false, "frame numbers a:b[:step], both ends included (default: all)", "SPEC"},
            {"--size", true, false, "image size (default 1280x720; contact sheet: sheet width 1920, tiles WxH-shaped)", "WxH"},
            {"--png", false, false, "write one PNG per frame instead of a movie"},
@@ -304,10 +343,11 @@ Command command_render() {
            {"--columns", true, false, "contact-sheet columns (default: about square)", "N"},
            {"--out", true, false, "output file (movie, sheet) or folder (--png)", "PATH"},
            {"--overwrite", false, false, "replace an existing output"},
-           {"--range", true, false, "fixed colour range instead of the frames' min..max", "LO:HI"},
-           {"--colormap", true, false, "viridis, magma or coolwarm (default: by field)", "NAME"},
+           {"--range", true, false, "fixed colour range instead of the frames' min..max (one field only)", "LO:HI"},
+           {"--colormap", true, false, "viridis, magma or coolwarm (default: by field; one field only)", "NAME"},
            {"--fps", true, false, "movie frames per second (default 10)", "N"},
-           {"--no-panel", false, false, "leave out the force panel"}},
+           {"--no-panel", false, false, "leave out the force panel"},
+           {"--smooth", false, false, "blend values between cell centres within the material (display only)"}},
           1,
           1,
           render_main};

@@ -12,6 +12,7 @@ Command command_templates();  // app/cmd_scene.cpp
 Command command_render();     // app/cmd_render.cpp
 Command command_demo();       // app/cmd_render.cpp
 Command command_compare();    // app/cmd_render.cpp
+Command command_inspect();    // app/cmd_inspect.cpp
 Command command_sweep();      // app/cmd_sweep.cpp
 Command command_study();      // app/cmd_study.cpp
 Command command_bench();      // app/cmd_bench.cpp
@@ -27,6 +28,8 @@ Scene load_varied_scene(const Parsed& p, const std::string& path, const std::vec
 // The --vary / --ladder specs (each KEYS=VALUES, no key twice); throws UsageError naming `option`,
 // with `if_none` when there are none.
 std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option, const std::string& if_none);
+// --size WxH (16..8192 each); throws UsageError (app/cmd_render.cpp).
+void parse_size(const std::string& s, int* w, int* h);
 // The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
 int parse_jobs(const Parsed& p);
 }  // namespace furrow::cli

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 
 #include "engine/field_store.hpp"
@@ -30,6 +31,47 @@ std::vector<float> checked_values(const FieldFrame& f, const std::string& field,
     throw std::runtime_error(path + ": " + e.what());
   }
 }
+
+// A stored frame with every field the image needs (else an error naming the file).
+FieldFrame read_with_fields(const std::string& path, const std::vector<std::string>& fields) {
+  FieldFrame f = read_checked(path);
+  for (const auto& field : fields) checked_values(f, field, path);
+  return f;
+}
+
+std::vector<std::string> field_names(const PanelsStyle& style) {
+  std::vector<std::string> names;
+  for (const auto& s : style.fields) names.push_back(s.field);
+  return names;
+}
+
+using DrawFrame = std::function<RgbImage(const FieldFrame&)>;
+
+void movie_of(const std::vector<std::string>& paths, const std::vector<std::string>& fields, int width, int height,
+              const DrawFrame& draw, const std::string& out_path, double fps, bool overwrite,
+              const FrameProgress& progress) {
+  if (paths.empty()) throw std::runtime_error(out_path + ": no frames to put in the movie");
+  MovieWriter movie(out_path, width, height, fps, overwrite);
+  for (size_t k = 0; k < paths.size(); ++k) {
+    movie.add_frame(draw(read_with_fields(paths[k], fields)));
+    if (progress) progress(k + 1, paths.size());
+  }
+  movie.finish();
+}
+
+std::vector<std::string> pngs_of(const std::vector<std::string>& paths, const std::vector<std::string>& fields,
+                                 const DrawFrame& draw, const std::string& out_dir, bool overwrite,
+                                 const FrameProgress& progress) {
+  fs::create_directories(out_dir);
+  std::vector<std::string> written;
+  for (size_t k = 0; k < paths.size(); ++k) {
+    const std::string out = (fs::path(out_dir) / (fs::path(paths[k]).stem().string() + ".png")).string();
+    write_png(draw(read_with_fields(paths[k], fields)), out, overwrite);
+    written.push_back(out);
+    if (progress) progress(k + 1, paths.size());
+  }
+  return written;
+}
 }  // namespace
 
 int time_decimals_for(const std::vector<double>& t) {
@@ -41,48 +83,56 @@ int time_decimals_for(const std::vector<double>& t) {
 }
 
 FrameScan scan_frames(const std::vector<std::string>& paths, const std::string& field) {
+  return scan_frames(paths, std::vector<std::string>{field}).front();
+}
+
+std::vector<FrameScan> scan_frames(const std::vector<std::string>& paths, const std::vector<std::string>& fields) {
   if (paths.empty()) throw std::runtime_error("no frames selected");
-  RangeAccumulator acc(field);
-  FrameScan scan;
+  std::vector<RangeAccumulator> acc;
+  for (const auto& field : fields) acc.emplace_back(field);
+  std::vector<double> times_s;
   for (const auto& path : paths) {
-    const FieldFrame f = read_checked(path);
-    checked_values(f, field, path);  // names the file if the field is missing
-    acc.add(f);
-    scan.times_s.push_back(f.time_s);
+    const FieldFrame f = read_with_fields(path, fields);  // names the file if a field is missing
+    for (auto& a : acc) a.add(f);
+    times_s.push_back(f.time_s);
   }
-  scan.range = acc.range();
-  scan.time_decimals = time_decimals_for(scan.times_s);
-  return scan;
+  std::vector<FrameScan> scans(fields.size());
+  for (size_t k = 0; k < fields.size(); ++k) {
+    scans[k].range = acc[k].range();
+    scans[k].times_s = times_s;
+    scans[k].time_decimals = time_decimals_for(times_s);
+  }
+  return scans;
 }
 
 void render_movie(const std::vector<std::string>& paths, const FrameStyle& style, const std::string& out_path,
                   double fps, bool overwrite, const FrameProgress& progress) {
   if (paths.empty()) throw std::runtime_error(out_path + ": no frames to put in the movie");
   FrameRenderer renderer(style);
-  MovieWriter movie(out_path, style.width, style.height, fps, overwrite);
-  for (size_t k = 0; k < paths.size(); ++k) {
-    const FieldFrame f = read_checked(paths[k]);
-    checked_values(f, style.field, paths[k]);
-    movie.add_frame(renderer.render(f));
-    if (progress) progress(k + 1, paths.size());
-  }
-  movie.finish();
+  movie_of(paths, {style.field}, style.width, style.height, [&](const FieldFrame& f) { return renderer.render(f); },
+           out_path, fps, overwrite, progress);
+}
+
+void render_movie(const std::vector<std::string>& paths, const PanelsStyle& style, const std::string& out_path,
+                  double fps, bool overwrite, const FrameProgress& progress) {
+  if (paths.empty()) throw std::runtime_error(out_path + ": no frames to put in the movie");
+  PanelsRenderer renderer(style);
+  movie_of(paths, field_names(style), style.width, style.height,
+           [&](const FieldFrame& f) { return renderer.render(f); }, out_path, fps, overwrite, progress);
 }
 
 std::vector<std::string> render_pngs(const std::vector<std::string>& paths, const FrameStyle& style,
                                      const std::string& out_dir, bool overwrite, const FrameProgress& progress) {
-  fs::create_directories(out_dir);
   FrameRenderer renderer(style);
-  std::vector<std::string> written;
-  for (size_t k = 0; k < paths.size(); ++k) {
-    const FieldFrame f = read_checked(paths[k]);
-    checked_values(f, style.field, paths[k]);
-    const std::string out = (fs::path(out_dir) / (fs::path(paths[k]).stem().string() + ".png")).string();
-    write_png(renderer.render(f), out, overwrite);
-    written.push_back(out);
-    if (progress) progress(k + 1, paths.size());
-  }
-  return written;
+  return pngs_of(paths, {style.field}, [&](const FieldFrame& f) { return renderer.render(f); }, out_dir, overwrite,
+                 progress);
+}
+
+std::vector<std::string> render_pngs(const std::vector<std::string>& paths, const PanelsStyle& style,
+                                     const std::string& out_dir, bool overwrite, const FrameProgress& progress) {
+  PanelsRenderer renderer(style);
+  return pngs_of(paths, field_names(style), [&](const FieldFrame& f) { return renderer.render(f); }, out_dir,
+                 overwrite, progress);
 }
 
 RgbImage render_contact_sheet(const std::vector<std::string>& paths, const FrameStyle& style, int columns,
@@ -124,6 +174,30 @@ RgbImage render_contact_sheet(const std::vector<std::string>& paths, const Frame
     if (progress) progress(size_t(k + 1), paths.size());
   }
   sheet.blit(band, (sheet.width - band.width) / 2, rows * tile_h);
+  return sheet;
+}
+
+RgbImage render_contact_sheet(const std::vector<std::string>& paths, const PanelsStyle& style, int columns,
+                              const FrameProgress& progress) {
+  if (style.fields.empty()) throw std::invalid_argument("contact sheet: no field given");
+  const int n = int(style.fields.size());
+  const int block_w = style.width / n;
+  std::vector<RgbImage> blocks;
+  for (int k = 0; k < n; ++k) {
+    FrameStyle s = style.fields[size_t(k)];
+    s.width = block_w;
+    s.height = style.height;  // tiles shaped like one field's panel
+    s.panel.reset();
+    blocks.push_back(render_contact_sheet(paths, s, columns, [&](size_t done, size_t total) {
+      if (progress) progress(size_t(k) * total + done, size_t(n) * total);
+    }));
+  }
+  int height = 0;
+  for (const auto& b : blocks) height = std::max(height, b.height);
+  const auto& bg = style.fields.front().background_rgb;
+  RgbImage sheet(n * block_w, height, uint8_t(std::lround(255 * bg[0])), uint8_t(std::lround(255 * bg[1])),
+                 uint8_t(std::lround(255 * bg[2])));
+  for (int k = 0; k < n; ++k) sheet.blit(blocks[size_t(k)], k * block_w, 0);
   return sheet;
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "render/field_panels.hpp"
 #include "render/frame_renderer.hpp"
 
 namespace furrow::render {
@@ -18,6 +19,8 @@ struct FrameScan {
 // Reads each frame once for its range and time. Throws naming the file that fails to read or
 // lacks the field.
 FrameScan scan_frames(const std::vector<std::string>& frame_paths, const std::string& field);
+// The same for several fields, reading each frame once: one scan per field, in order.
+std::vector<FrameScan> scan_frames(const std::vector<std::string>& frame_paths, const std::vector<std::string>& fields);
 
 // Decimals that tell consecutive times apart: max(3, digits of the smallest spacing).
 int time_decimals_for(const std::vector<double>& times_s);
@@ -29,14 +32,24 @@ using FrameProgress = std::function<void(size_t done, size_t total)>;
 void render_movie(const std::vector<std::string>& frame_paths, const FrameStyle& style, const std::string& out_path,
                   double fps, bool overwrite, const FrameProgress& progress = {});
 
+// The same with several fields side by side (PanelsRenderer); style.width/height is the movie's size.
+void render_movie(const std::vector<std::string>& frame_paths, const PanelsStyle& style, const std::string& out_path,
+                  double fps, bool overwrite, const FrameProgress& progress = {});
+
 // One PNG per frame in `out_dir` (created if missing), named like the frame file
 // (frame_00042.vdb -> frame_00042.png). Returns the paths written.
 std::vector<std::string> render_pngs(const std::vector<std::string>& frame_paths, const FrameStyle& style,
+                                     const std::string& out_dir, bool overwrite, const FrameProgress& progress = {});
+std::vector<std::string> render_pngs(const std::vector<std::string>& frame_paths, const PanelsStyle& style,
                                      const std::string& out_dir, bool overwrite, const FrameProgress& progress = {});
 
 // The frames as tiles in a grid of `columns` (0: about square), each tile labelled with its time,
 // above one shared colorbar. style.width is the sheet width; tiles keep style's aspect ratio.
 RgbImage render_contact_sheet(const std::vector<std::string>& frame_paths, const FrameStyle& style, int columns,
+                              const FrameProgress& progress = {});
+// Several fields: one such sheet per field (each with its colorbar, tiles shaped
+// style.width / fields x style.height), side by side in style.width; no force plot.
+RgbImage render_contact_sheet(const std::vector<std::string>& frame_paths, const PanelsStyle& style, int columns,
                               const FrameProgress& progress = {});
 
 }  // namespace furrow::render

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <tuple>
 #include <stdexcept>
 
 #include <vtkActor.h>
+#include <vtkActor2D.h>
 #include <vtkAxis.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
@@ -14,6 +16,8 @@
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
+#include <vtkCoordinate.h>
+#include <vtkCellData.h>
 #include <vtkFloatArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkImageActor.h>
@@ -29,15 +33,19 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPolyDataMapper2D.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkRenderer.h>
-#include <vtkScalarBarActor.h>
 #include <vtkTable.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
 
 #include "render/colormap.hpp"
 #include "render/gl_context.hpp"
+#include "render/smooth.hpp"
+#include "render/ticks.hpp"
 
 namespace furrow::render {
 
@@ -158,9 +166,13 @@ std::string default_colormap(const std::string& field, const FieldRange& range) 
 }
 
 std::string colorbar_title(const std::string& field, bool log_scale) {
+  return colorbar_title(field, log_scale, require_field(field).unit);
+}
+
+std::string colorbar_title(const std::string& field, bool log_scale, const std::string& display_unit) {
   const FieldInfo& info = require_field(field);
   std::string t = info.label + (info.vector ? " magnitude" : "");
-  std::string unit = info.unit == "-" ? "" : info.unit;
+  std::string unit = display_unit == "-" ? "" : display_unit;
   if (log_scale) unit += std::string(unit.empty() ? "" : ", ") + "log scale";
   if (!unit.empty()) t += " (" + unit + ")";
   return t;
@@ -178,7 +190,11 @@ struct FrameRenderer::Pipeline {
   vtkNew<vtkPolyData> outlines;
   vtkNew<vtkPolyDataMapper> outline_mapper;
   vtkNew<vtkActor> outline_actor;
-  vtkNew<vtkScalarBarActor> colorbar;
+  // colorbar: one quad per colormap entry, tick marks, and a label under each tick
+  vtkNew<vtkPolyData> bar, tick_marks;
+  vtkNew<vtkPolyDataMapper2D> bar_mapper, tick_mapper;
+  vtkNew<vtkActor2D> bar_actor, tick_actor;
+  std::vector<vtkSmartPointer<vtkTextActor>> tick_labels;
   vtkNew<vtkTextActor> colorbar_title;
   vtkNew<vtkTextActor> title;
   vtkNew<vtkTextActor> time;
@@ -235,16 +251,6 @@ void series_until(const ForceSeries& s, double time, std::vector<double>& x, std
     x.push_back(s.x[k - 1] + w * (s.x[k] - s.x[k - 1]));
     y.push_back(s.y[k - 1] + w * (s.y[k] - s.y[k - 1]));
   }
-}
-
-// Plain decimals sized to the range (0, 742, 1485 Pa; 0.550 for packing), exponents only for
-// very large or small values; log scales label their decades.
-std::string label_format(const FieldRange& r) {
-  if (r.log) return "%.2g";
-  const double big = std::max(std::abs(r.lo), std::abs(r.hi)), span = r.hi - r.lo;
-  if (big >= 1e5 || big < 1e-3) return "%.2e";
-  const int decimals = std::clamp(2 - int(std::floor(std::log10(span))), 0, 6);
-  return "%." + std::to_string(decimals) + "f";
 }
 
 const std::array<unsigned char, 3> kSeriesColors[] = {{31, 92, 180}, {214, 88, 20}, {40, 150, 60}, {150, 50, 160}};
@@ -317,31 +323,73 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
   layout_.bed_y0 = top_band, layout_.bed_y1 = H - bottom_band;
 
   if (style.show_colorbar) {
-    p.colorbar->SetLookupTable(p.lut);
-    p.colorbar->SetOrientationToHorizontal();
-    p.colorbar->SetTitle("");  // VTK puts its title among the labels; ours sits above the bar
-    p.colorbar->SetNumberOfLabels(5);
-    p.colorbar->SetLabelFormat(label_format(style.range).c_str());
-    p.colorbar->UnconstrainedFontSizeOn();
-    p.colorbar->SetTextPositionToPrecedeScalarBar();  // title above, labels below the bar
-    p.colorbar->SetMaximumNumberOfColors(int(cmap.rgb.size()));
-    p.colorbar->SetBarRatio(0.32);
-    p.colorbar->SetTextPad(int(std::lround(4 * font_scale)));
-    for (vtkTextProperty* tp : {p.colorbar->GetTitleTextProperty(), p.colorbar->GetLabelTextProperty()}) {
-      tp->SetColor(text_rgb);
-      tp->ShadowOff();
-      tp->BoldOff();
-      tp->ItalicOff();
-      tp->SetFontFamilyToArial();
+    // the bar: one quad per colormap entry, so its colours are exactly the table's
+    const int bar_y1 = bar_y0 + int(std::lround(0.35 * (cb_y1 - bar_y0)));
+    const int tick_len = std::max(3, int(std::lround(6 * font_scale)));
+    layout_.colorbar_bar_y0 = bar_y0, layout_.colorbar_bar_y1 = bar_y1;
+    vtkNew<vtkPoints> bar_pts;
+    vtkNew<vtkCellArray> quads;
+    vtkNew<vtkUnsignedCharArray> rgb;
+    rgb->SetNumberOfComponents(3);
+    const size_t n = cmap.rgb.size();
+    for (size_t k = 0; k <= n; ++k) {
+      const double x = cb_x0 + (cb_x1 - cb_x0) * double(k) / double(n);
+      bar_pts->InsertNextPoint(x, H - bar_y1, 0.0);
+      bar_pts->InsertNextPoint(x, H - bar_y0, 0.0);
     }
-    p.colorbar->GetTitleTextProperty()->SetFontSize(title_px - 2);
-    p.colorbar->GetLabelTextProperty()->SetFontSize(label_px);
-    p.colorbar->GetPositionCoordinate()->SetCoordinateSystemToViewport();
-    p.colorbar->GetPosition2Coordinate()->SetCoordinateSystemToViewport();
-    p.colorbar->GetPositionCoordinate()->SetValue(cb_x0, H - cb_y1);
-    p.colorbar->GetPosition2Coordinate()->SetValue(cb_x1 - cb_x0, cb_y1 - bar_y0);
-    p.field_ren->AddActor2D(p.colorbar);
-    p.colorbar_title->SetInput(colorbar_title(style.field, style.range.log).c_str());
+    for (size_t k = 0; k < n; ++k) {
+      const vtkIdType q[4] = {vtkIdType(2 * k), vtkIdType(2 * k + 2), vtkIdType(2 * k + 3), vtkIdType(2 * k + 1)};
+      quads->InsertNextCell(4, q);
+      const unsigned char c[3] = {(unsigned char)std::lround(255 * cmap.rgb[k][0]),
+                                  (unsigned char)std::lround(255 * cmap.rgb[k][1]),
+                                  (unsigned char)std::lround(255 * cmap.rgb[k][2])};
+      rgb->InsertNextTypedTuple(c);
+    }
+    p.bar->SetPoints(bar_pts);
+    p.bar->SetPolys(quads);
+    p.bar->GetCellData()->SetScalars(rgb);
+    // ticks at round values (render/ticks.hpp), labelled in a prefixed unit (kPa)
+    const int max_ticks = std::clamp((cb_x1 - cb_x0) / (7 * label_px), 3, 6);
+    const Ticks ticks = choose_ticks(style.range.lo, style.range.hi, max_ticks, style.range.log, require_field(style.field).unit);
+    vtkNew<vtkPoints> tick_pts;
+    vtkNew<vtkCellArray> tick_lines;
+    for (size_t k = 0; k < ticks.values.size(); ++k) {
+      const double x = cb_x0 + (cb_x1 - cb_x0) * range_fraction(ticks.values[k], style.range.lo, style.range.hi, style.range.log);
+      const vtkIdType a = tick_pts->InsertNextPoint(x, H - bar_y1, 0.0);
+      const vtkIdType b = tick_pts->InsertNextPoint(x, H - bar_y1 - tick_len, 0.0);
+      const vtkIdType ab[2] = {a, b};
+      tick_lines->InsertNextCell(2, ab);
+      auto label = vtkSmartPointer<vtkTextActor>::New();
+      label->SetInput(ticks.labels[k].c_str());
+      vtkTextProperty* tp = label->GetTextProperty();
+      tp->SetFontSize(label_px);
+      tp->SetColor(text_rgb);
+      tp->SetFontFamilyToArial();
+      tp->SetJustificationToCentered();
+      tp->SetVerticalJustificationToTop();
+      label->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+      label->GetPositionCoordinate()->SetValue(x, H - bar_y1 - tick_len - 2);
+      p.field_ren->AddActor2D(label);
+      p.tick_labels.push_back(label);
+      layout_.colorbar_ticks.push_back({x, ticks.values[k], ticks.labels[k]});
+    }
+    layout_.colorbar_unit = ticks.unit;
+    p.tick_marks->SetPoints(tick_pts);
+    p.tick_marks->SetLines(tick_lines);
+    for (auto [mapper, data, actor] : {std::tuple{p.bar_mapper.Get(), p.bar.Get(), p.bar_actor.Get()},
+                                       std::tuple{p.tick_mapper.Get(), p.tick_marks.Get(), p.tick_actor.Get()}}) {
+      vtkNew<vtkCoordinate> viewport;
+      viewport->SetCoordinateSystemToViewport();
+      mapper->SetInputData(data);
+      mapper->SetTransformCoordinate(viewport);
+      mapper->SetScalarModeToUseCellData();
+      mapper->SetColorModeToDirectScalars();
+      actor->SetMapper(mapper);
+      p.field_ren->AddActor2D(actor);
+    }
+    p.tick_actor->GetProperty()->SetColor(text_rgb);
+    p.tick_actor->GetProperty()->SetLineWidth(float(std::max(1.0, 1.5 * font_scale)));
+    p.colorbar_title->SetInput(colorbar_title(style.field, style.range.log, ticks.unit).c_str());
     vtkTextProperty* tp = p.colorbar_title->GetTextProperty();
     tp->SetFontSize(title_px - 2);
     tp->SetColor(text_rgb);
@@ -454,16 +502,6 @@ RgbImage FrameRenderer::render(const FieldFrame& frame) {
       if (!std::isnan(x) && !(x > lo)) x = lo;  // no flow (rate 0) shows as the bottom colour
   }
 
-  // field texture: one image point per cell, at the cell centre
-  p.image->SetDimensions(frame.nx, frame.ny, 1);
-  p.image->SetSpacing(frame.dx_m, frame.dx_m, 1.0);
-  p.image->SetOrigin(frame.origin_m.x() + 0.5 * frame.dx_m, frame.origin_m.y() + 0.5 * frame.dx_m, 0.0);
-  p.values->SetNumberOfComponents(1);
-  p.values->SetNumberOfTuples(vtkIdType(v.size()));
-  std::copy(v.begin(), v.end(), p.values->GetPointer(0));
-  p.values->Modified();
-  p.image->Modified();
-
   // fit the bed box into the field area, aspect ratio preserved
   const int fa_w = style_.panel ? even_floor(W * (1.0 - kPanelFraction)) : W;
   const int top_band = int(std::lround(0.09 * H));
@@ -478,6 +516,19 @@ RgbImage FrameRenderer::render(const FieldFrame& frame) {
   layout_.bed_y0 = top_band + 0.5 * (avail_h - bed_h * ppm);
   layout_.bed_y1 = layout_.bed_y0 + bed_h * ppm;
   layout_.bed_origin_m = frame.origin_m;
+  // field texture: one image point per cell (or per sub-cell when smoothed), at its centre
+  const int sub = style_.smooth ? std::clamp(int(std::ceil(ppm * frame.dx_m / 2.0)), 2, 8) : 1;  // ~2 px each
+  if (sub > 1) v = upsample_within_material(v, frame.nx, frame.ny, sub, style_.range.log);
+  const double h = frame.dx_m / sub;
+  p.image->SetDimensions(frame.nx * sub, frame.ny * sub, 1);
+  p.image->SetSpacing(h, h, 1.0);
+  p.image->SetOrigin(frame.origin_m.x() + 0.5 * h, frame.origin_m.y() + 0.5 * h, 0.0);
+  p.values->SetNumberOfComponents(1);
+  p.values->SetNumberOfTuples(vtkIdType(v.size()));
+  std::copy(v.begin(), v.end(), p.values->GetPointer(0));
+  p.values->Modified();
+  p.image->Modified();
+
   // camera: world point under the centre of the field viewport; parallel scale = half its height
   const Eigen::Vector2d centre_m(frame.origin_m.x() + (0.5 * fa_w - layout_.bed_x0) / ppm,
                                  frame.origin_m.y() + (layout_.bed_y1 - 0.5 * H) / ppm);

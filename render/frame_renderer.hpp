@@ -78,6 +78,9 @@ struct FrameStyle {
   int time_decimals = 3;
   double font_scale = 0.0;  // text size relative to a 720-pixel-high image; 0: height / 720
   std::optional<ForcePanel> panel;  // side panel (right ~38% of the image)
+  // Display only: blend values between cell centres inside the material on a finer image
+  // (render/smooth.hpp); cells without material stay empty, so the free surface stays sharp.
+  bool smooth = false;
   std::array<float, 3> empty_rgb{0.82f, 0.82f, 0.82f};     // cells with no material
   std::array<float, 3> outline_rgb{0.0f, 0.9f, 1.0f};      // body outlines (cyan: in no colormap)
   std::array<float, 3> background_rgb{1.0f, 1.0f, 1.0f};
@@ -88,7 +91,15 @@ struct FrameLayout {
   double bed_x0 = 0, bed_y0 = 0, bed_x1 = 0, bed_y1 = 0;  // the bed box (field texture) edges
   double px_per_m = 0;
   Eigen::Vector2d bed_origin_m{0, 0};                  // world point at (bed_x0, bed_y1)
-  int colorbar_x0 = 0, colorbar_y0 = 0, colorbar_x1 = 0, colorbar_y1 = 0;
+  int colorbar_x0 = 0, colorbar_y0 = 0, colorbar_x1 = 0, colorbar_y1 = 0;  // title, bar and labels
+  int colorbar_bar_y0 = 0, colorbar_bar_y1 = 0;                              // the coloured bar itself
+  struct Tick {
+    double x_px = 0;  // centre of the tick mark and its label
+    double value = 0; // SI
+    std::string label;
+  };
+  std::vector<Tick> colorbar_ticks;  // empty without a colorbar
+  std::string colorbar_unit;         // unit the labels read in, e.g. "kPa"
   int time_x0 = 0, time_y0 = 0, time_x1 = 0, time_y1 = 0;  // box the time stamp is drawn in
   int panel_x0 = 0, panel_x1 = 0;                          // 0, 0 when there is no panel
   // Pixel (x right, y down) of a world point.
@@ -118,7 +129,9 @@ class FrameRenderer {
   std::unique_ptr<Pipeline> p_;
 };
 
-// Colorbar title: "Pressure (Pa)", "Velocity magnitude (m/s)", "Packing fraction" (unit "-").
+// Colorbar title: "Pressure (Pa)", "Velocity magnitude (m/s)", "Packing fraction" (unit "-");
+// with a display unit (the ticks' prefixed one): "Pressure (kPa)".
 std::string colorbar_title(const std::string& field, bool log_scale);
+std::string colorbar_title(const std::string& field, bool log_scale, const std::string& display_unit);
 
 }  // namespace furrow::render

@@ -1,11 +1,13 @@
 // FrameRenderer on synthetic frames with known fields (DISPLAY unset). Set FURROW_TEST_DUMP=DIR
 // to keep the rendered images for a look.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
+#include "engine/field_store.hpp"
 #include "render/colormap.hpp"
 #include "render/frame_renderer.hpp"
 #include "tests/render/capture_output.hpp"
@@ -257,4 +259,142 @@ TEST(FrameRenderer, RangeAccumulatorUsesActiveCellsAndLogFloor) {
   EXPECT_EQ(colorbar_title("pressure", false), "Pressure (Pa)");
   EXPECT_EQ(colorbar_title("packing_fraction", false), "Packing fraction");
   EXPECT_EQ(colorbar_title("velocity", false), "Velocity magnitude (m/s)");
+}
+
+TEST(FrameRenderer, ColorbarTicksSitAtRoundValuesInKilopascal) {
+  // 0..2967 Pa: ticks every 0.5 kPa, each where the bar shows that value's colour, text under each
+  FrameStyle style;
+  style.field = "pressure";
+  style.range = {0.0, max_pressure(), false};
+  FrameRenderer r(style);
+  const RgbImage img = r.render(test_frame());
+  dump(img, "colorbar_ticks");
+  const FrameLayout& L = r.layout();
+  EXPECT_EQ(L.colorbar_unit, "kPa");
+  std::vector<std::string> labels;
+  for (const auto& t : L.colorbar_ticks) labels.push_back(t.label);
+  EXPECT_EQ(labels, (std::vector<std::string>{"0", "0.5", "1.0", "1.5", "2.0", "2.5"}));
+  const Colormap& cmap = load_colormap("viridis");
+  const int y_bar = (L.colorbar_bar_y0 + L.colorbar_bar_y1) / 2;
+  for (const auto& t : L.colorbar_ticks) {
+    const int x = std::clamp(int(std::lround(t.x_px)), L.colorbar_x0 + 1, L.colorbar_x1 - 2);
+    double dist = 0;
+    const int idx = cmap.nearest_index(img.at(x, y_bar), &dist);
+    EXPECT_LE(dist, 3.0) << t.label;
+    EXPECT_NEAR(idx, std::min(255.0, 256.0 * t.value / max_pressure()), 2.0) << t.label;
+    // a dark tick mark just under the bar and label text centred under it
+    int dark = 0;
+    for (int y = L.colorbar_bar_y1; y < L.colorbar_y1; ++y)
+      for (int xx = x - 12; xx <= x + 12; ++xx) dark += img.at(xx, y)[0] < 90 && img.at(xx, y)[2] < 90;
+    EXPECT_GT(dark, 15) << t.label;
+  }
+  // between two ticks, under the bar: no text
+  const int gap_x = int(0.5 * (L.colorbar_ticks[1].x_px + L.colorbar_ticks[2].x_px));
+  int dark_gap = 0;
+  for (int y = L.colorbar_bar_y1; y < L.colorbar_y1; ++y)
+    for (int x = gap_x - 10; x <= gap_x + 10; ++x) dark_gap += img.at(x, y)[0] < 90 && img.at(x, y)[2] < 90;
+  EXPECT_EQ(dark_gap, 0);
+  // the title reads in the labels' unit
+  EXPECT_EQ(colorbar_title("pressure", false, L.colorbar_unit), "Pressure (kPa)");
+}
+
+TEST(FrameRenderer, LogColorbarHasDecadeTicks) {
+  FrameStyle style;
+  style.field = "strain_rate";
+  style.range = {1e-3, 10.0, true};
+  FrameRenderer r(style);
+  r.render(test_frame());
+  const FrameLayout& L = r.layout();
+  ASSERT_EQ(L.colorbar_ticks.size(), 5u);
+  const double bar_w = L.colorbar_x1 - L.colorbar_x0;
+  for (size_t k = 0; k < 5; ++k) {
+    EXPECT_NEAR(L.colorbar_ticks[k].value, std::pow(10.0, double(k) - 3.0), 1e-12);
+    EXPECT_NEAR(L.colorbar_ticks[k].x_px, L.colorbar_x0 + bar_w * double(k) / 4.0, 1e-6);  // evenly spaced
+  }
+  EXPECT_EQ(L.colorbar_ticks[0].label, "0.001");
+  EXPECT_EQ(L.colorbar_ticks[4].label, "10");
+  EXPECT_EQ(L.colorbar_unit, "1/s");
+}
+
+TEST(FrameRenderer, SmoothDisplayStaysInsideTheMaterialAndRemovesTheStaircase) {
+  // a stored frame in coarse 1 cm cells whose free surface slopes: material only below it
+  FieldFrame f = test::hydrostatic_frame(40, 25, 0.01, 0.2);
+  for (int j = 0; j < f.ny; ++j)
+    for (int i = 0; i < f.nx; ++i)
+      if ((j + 0.5) * 0.01 > 0.1 + 0.25 * (i + 0.5) * 0.01) {
+        f.active[f.index(i, j)] = 0;
+        f.scalars["pressure"][f.index(i, j)] = 0.f;
+      }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("furrow_smooth_" + std::to_string(::getpid()) + ".vdb")).string();
+  write_frame_vdb(path, f);
+  const FieldFrame stored = read_frame(path);
+  std::filesystem::remove(path);
+  const std::vector<float> stored_pressure = stored.scalars.at("pressure");
+
+  FrameStyle style;
+  style.field = "pressure";
+  style.width = 960, style.height = 540;
+  style.range = {0.0, max_pressure(), false};
+  FrameRenderer flat_r(style);
+  style.smooth = true;
+  FrameRenderer smooth_r(style);
+  const RgbImage flat = flat_r.render(stored), smooth = smooth_r.render(stored);
+  dump(smooth, "smooth");
+  EXPECT_EQ(stored.scalars.at("pressure"), stored_pressure);  // display only
+  const FrameLayout& L = smooth_r.layout();
+  const double cell_px = L.px_per_m * 0.01;
+  ASSERT_GT(cell_px, 8.0);
+  const Colormap& cmap = load_colormap("viridis");
+  // the cell under a pixel centre; `margin`: whether it lies 1.5 px clear of the cell's edges
+  auto cell_of = [&](int x, int y, bool* clear) -> long {
+    const double cx = (x + 0.5 - L.bed_x0) / cell_px, cy = (L.bed_y1 - y - 0.5) / cell_px;
+    if (cx <= 0 || cy <= 0 || cx >= f.nx || cy >= f.ny) return -1;
+    const double m = 1.5 / cell_px;
+    *clear = cx - std::floor(cx) > m && std::ceil(cx) - cx > m && cy - std::floor(cy) > m && std::ceil(cy) - cy > m;
+    return long(stored.index(int(cx), int(cy)));
+  };
+  // a cell whose 8 neighbours all hold material (away from the free surface)
+  auto deep_inside = [&](long c) {
+    const int i = int(c % f.nx), j = int(c / f.nx);
+    for (int b = -1; b <= 1; ++b)
+      for (int a = -1; a <= 1; ++a) {
+        const int ii = std::clamp(i + a, 0, f.nx - 1), jj = std::clamp(j + b, 0, f.ny - 1);
+        if (!stored.active[stored.index(ii, jj)]) return false;
+      }
+    return true;
+  };
+  int outside_material = 0, empty_checked = 0, material_checked = 0, pairs = 0;
+  double sq_flat = 0, sq_smooth = 0;
+  for (int y = int(L.bed_y0); y + 1 < int(L.bed_y1); ++y)
+    for (int x = int(L.bed_x0); x < int(L.bed_x1); ++x) {
+      bool clear = false, unused = false;
+      const long c = cell_of(x, y, &clear);
+      if (c < 0) continue;
+      if (clear && !stored.active[size_t(c)]) {
+        ++empty_checked;
+        outside_material += !near_rgb(smooth.at(x, y), style.empty_rgb, 1);
+      }
+      if (clear && stored.active[size_t(c)]) {
+        ++material_checked;
+        double d = 0;
+        cmap.nearest_index(smooth.at(x, y), &d);
+        EXPECT_LE(d, 3.0) << "not a colormap colour at (" << x << ", " << y << ")";
+      }
+      // vertical neighbours inside the material, across cell edges too (the field varies with depth)
+      const long below = cell_of(x, y + 1, &unused);
+      if (below < 0 || !deep_inside(c) || !deep_inside(below)) continue;
+      const int s0 = cmap.nearest_index(smooth.at(x, y)), s1 = cmap.nearest_index(smooth.at(x, y + 1));
+      const int f0 = cmap.nearest_index(flat.at(x, y)), f1 = cmap.nearest_index(flat.at(x, y + 1));
+      sq_smooth += double(s1 - s0) * (s1 - s0);
+      sq_flat += double(f1 - f0) * (f1 - f0);
+      ++pairs;
+    }
+  EXPECT_GT(empty_checked, 10000);
+  EXPECT_GT(material_checked, 20000);
+  EXPECT_GT(pairs, 20000);
+  EXPECT_EQ(outside_material, 0) << "smoothed colour outside the material mask";
+  // per-cell colours jump ~13 indices at each cell row and not between; the blend ~1 per pixel
+  // row: the mean squared jump drops by about the pixels per cell
+  EXPECT_GT(sq_flat, 4.0 * sq_smooth) << "mean squared jump, flat " << sq_flat / pairs << ", smooth " << sq_smooth / pairs;
 }

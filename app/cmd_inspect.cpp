@@ -1,0 +1,95 @@
+// `furrow inspect`: argument handling only; the inspector's state, actions and drawing live in
+// render/inspector.
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "app/commands.hpp"
+#include "render/inspector.hpp"
+#include "render/inspector_window.hpp"
+
+namespace fs = std::filesystem;
+
+namespace furrow::cli {
+
+namespace {
+
+int inspect_main(const Parsed& p) {
+  const std::string run_dir = p.positional[0];
+  if (!fs::is_directory(run_dir)) {
+    std::cerr << "furrow inspect: run directory '" << run_dir << "' does not exist\n";
+    return 1;
+  }
+  const bool headless = p.has("--headless");
+  if (headless && !p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
+  if (!headless && !render::inspector_window_available()) {
+    std::cerr << "furrow inspect: this furrow was built without GLFW/X11 and has no window; use --headless --script FILE\n";
+    return 2;
+  }
+  const char* display = std::getenv("DISPLAY");
+  if (!headless && !(display && *display)) {
+    std::cerr << "furrow inspect: no display (DISPLAY is not set) for the window; use --headless --script FILE\n";
+    return 2;
+  }
+  if (p.has("--exit-after-script") && (headless || !p.has("--script")))
+    throw UsageError("--exit-after-script is for a --script replayed in the window (without --headless)");
+  int width = 1280, height = 720;
+  if (p.has("--size")) {
+    parse_size(p.get("--size"), &width, &height);
+    if (width < 400 || height < 300) throw UsageError("--size: the inspector needs at least 400x300, got '" + p.get("--size") + "'");
+  }
+  // the whole script is checked before anything runs
+  const std::string script = p.get("--script");
+  const std::vector<render::ScriptStep> steps = script.empty() ? std::vector<render::ScriptStep>{}
+                                                               : render::parse_inspect_script(script);
+
+  render::InspectorState state = render::open_run(run_dir, p.get("--field"));
+  render::InspectorView view(width, height, p.has("--smooth"));
+  if (!headless) {
+    render::WindowOptions w;
+    w.script = steps, w.script_path = script, w.exit_after_script = p.has("--exit-after-script");
+    return render::run_inspector_window(state, view, w, std::cout, std::cerr);
+  }
+  for (const auto& step : steps) {
+    nlohmann::json r;
+    try {
+      r = render::apply_action(state, step.action, &view);
+    } catch (const std::exception& e) {
+      std::cerr << "furrow inspect: " << script << ":" << step.line << ": " << e.what() << "\n";
+      return 1;
+    }
+    r["line"] = step.line;
+    std::cout << r.dump() << "\n" << std::flush;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command command_inspect() {
+  return {"inspect",
+          "inspect a stored run in a window, or replay a script headless: probe, profile, measure, screenshot",
+          "furrow inspect RUN_DIR [--headless] [--script FILE [--exit-after-script]] [--field NAME] [--size WxH] [--smooth]",
+          std::string("Opens the frames stored in RUN_DIR (frames/*.vdb, forces.csv). In a window (a display is\n"
+                      "needed): the frame and the inspector panel; pick the field and frame in the panel, click\n"
+                      "on the bed to probe, Left/Right for the previous/next frame, S for a screenshot\n"
+                      "(inspect.png, inspect_2.png, ...), Esc or Q to quit; a --script is replayed there first and\n"
+                      "its screenshots are read back from the window. With --headless, replays the actions of\n"
+                      "FILE against an off-screen view. Either way each result is one JSON object on stdout (SI units;\n"
+                      "every object has \"action\", a script's also its \"line\"; a value where there is no\n"
+                      "material is null). The whole script is checked first: a bad line is an error naming FILE, the line and\n"
+                      "what was expected, and nothing runs. Colour ranges are fixed over the run, as in movies.\n"
+                      "A screenshot never replaces an existing file.\n\n") +
+              render::kInspectScriptHelp,
+          {{"--headless", false, false, "no window: replay --script off-screen"},
+           {"--script", true, false, "the actions to replay, one per line", "FILE"},
+           {"--exit-after-script", false, false, "close the window once the script has run"},
+           {"--field", true, false, "field selected at the start (default: strain_rate, else pressure, ...)", "NAME"},
+           {"--size", true, false, "screenshot size (default 1280x720; the panel takes a third, up to 420 px)", "WxH"},
+           {"--smooth", false, false, "draw fields smoothed within the material (display only)"}},
+          1,
+          1,
+          inspect_main};
+}
+
+}  // namespace furrow::cli

@@ -1,0 +1,229 @@
+// `furrow inspect --headless --script`, run as a user would with no display: probes equal the
+// stored VDB values, profiles cross the free surface, a known angle, and a screenshot with the
+// ImGui panel.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <sstream>
+#include <thread>
+
+#include "engine/field_store.hpp"
+#include "render/colormap.hpp"
+#include "render/image_io.hpp"
+#include "tests/app/cli_fixture.hpp"
+#include "tests/app/stored_run.hpp"
+
+namespace {
+
+using furrow::cli_test::StoredRun;
+using nlohmann::json;
+
+// A screenshot of the view: the field in `colormap` colours left of x0 and the ImGui panel (a dark
+// window with light text and the plot) from x0 on.
+void expect_inspector_view(const furrow::render::RgbImage& img, int x0, const std::string& colormap) {
+  int dark = 0, bright = 0, panel = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = x0; x < img.width; ++x) {
+      const uint8_t* p = img.at(x, y);
+      ++panel;
+      dark += p[0] < 120 && p[1] < 120 && p[2] < 120;
+      bright += p[0] > 180 && p[1] > 180 && p[2] > 180 && x > x0 + 4 && y > 24;  // text on the dark window
+    }
+  EXPECT_GT(dark, panel / 2) << "the panel's dark window fills its region";
+  EXPECT_GT(bright, 500) << "text and the plot in the panel";
+  const auto& cmap = furrow::render::load_colormap(colormap);
+  int field_px = 0;
+  for (int y = 0; y < img.height; y += 2)
+    for (int x = 0; x < x0; x += 2) {
+      double d = 0;
+      cmap.nearest_index(img.at(x, y), &d);
+      field_px += d < 2.0;
+    }
+  EXPECT_GT(field_px, 10000) << "the field in " << colormap << " colours";
+}
+
+class InspectCli : public furrow::cli_test::CliFixture {
+ protected:
+  InspectCli() : CliFixture("furrow_inspect_cli_") {}
+  std::string script(const std::string& text) {
+    const std::string p = path("script.txt");
+    std::ofstream(p) << text;
+    return p;
+  }
+  static std::vector<json> lines(const std::string& out) {
+    std::vector<json> v;
+    std::istringstream in(out);
+    for (std::string l; std::getline(in, l);) v.push_back(json::parse(l));
+    return v;
+  }
+};
+
+TEST_F(InspectCli, ScriptedSessionProbesProfilesMeasuresAndScreenshots) {
+  const StoredRun stored(dir_ / "run");
+  const std::string shot = path("view.png");
+  const auto r = run({"inspect", (dir_ / "run").string(), "--headless", "--script",
+                      script("# a session on frame 2\n"
+                             "field pressure\n"
+                             "frame 2\n"
+                             "probe 0.1025 0.0525\n"
+                             "probe 0.1 0.23   # above the free surface\n"
+                             "profile 0.0525 0.0025 0.0525 0.2425 25\n"
+                             "angle 0.25 0.206 0.15 0.186 0.25 0.186\n"
+                             "length 0.15 0.186 0.25 0.186\n"
+                             "time 0.031\n"
+                             "screenshot " + shot + "\n")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<json> out = lines(r.out);
+  ASSERT_EQ(out.size(), 9u) << r.out;
+  EXPECT_EQ(out[0]["action"], "field");
+  EXPECT_EQ(out[0]["unit"], "Pa");
+  EXPECT_EQ(out[1]["frame"], 2);
+  EXPECT_NEAR(out[1]["time_s"].get<double>(), 0.02, 1e-12);
+
+  // probe: the values of cell (20, 10) of frame_00002.vdb read directly
+  const furrow::FieldFrame f = furrow::read_frame(stored.frames[2]);
+  const size_t k = f.index(20, 10);
+  const json& probe = out[2];
+  EXPECT_EQ(probe["line"], 4);
+  EXPECT_EQ(probe["cell"], json::array({20, 10}));
+  EXPECT_TRUE(probe["material"].get<bool>());
+  EXPECT_EQ(float(probe["values"]["pressure"].get<double>()), f.scalars.at("pressure")[k]);
+  EXPECT_EQ(float(probe["values"]["strain_rate"].get<double>()), f.scalars.at("strain_rate")[k]);
+  EXPECT_EQ(float(probe["values"]["velocity"][0].get<double>()), f.velocity_x[k]);
+  EXPECT_EQ(float(probe["values"]["velocity"][1].get<double>()), f.velocity_y[k]);
+  EXPECT_EQ(probe["units"]["pressure"], "Pa");
+  EXPECT_NEAR(probe["values"]["pressure"].get<double>(), 1.2 * 1512 * 9.81 * (0.2 - 0.0525), 0.1);
+  EXPECT_TRUE(probe["inside_body"].is_null());
+  EXPECT_FALSE(out[3]["material"].get<bool>());
+  EXPECT_TRUE(out[3]["values"]["pressure"].is_null());
+
+  // profile: 25 points 1 cm apart up x = 0.0525; material below 0.2 m, pressure falling with height
+  const json& prof = out[4];
+  ASSERT_EQ(prof["values"].size(), 25u);
+  EXPECT_EQ(prof["field"], "pressure");
+  int with_material = 0;
+  for (size_t n = 0; n < 25; ++n) {
+    const double y = prof["y_m"][n].get<double>();
+    EXPECT_NEAR(y, 0.0025 + 0.01 * double(n), 1e-12);
+    EXPECT_NEAR(prof["s_m"][n].get<double>(), 0.01 * double(n), 1e-12);
+    const json& v = prof["values"][n];
+    if (y < 0.2) {
+      ASSERT_TRUE(v.is_number()) << "y = " << y;
+      EXPECT_EQ(float(v.get<double>()), f.scalars.at("pressure")[f.index(10, int(y / 0.005))]);
+      if (n > 0) {
+        EXPECT_LT(v.get<double>(), prof["values"][n - 1].get<double>());
+      }
+      ++with_material;
+    } else {
+      EXPECT_TRUE(v.is_null()) << "y = " << y;
+    }
+  }
+  EXPECT_EQ(with_material, 20);
+
+  // the angle between the plate's bottom and its diagonal: atan(20 mm / 100 mm)
+  EXPECT_NEAR(out[5]["deg"].get<double>(), std::atan(0.2) * 180 / M_PI, 0.5);
+  EXPECT_NEAR(out[5]["deg"].get<double>(), 11.3099, 1e-3);
+  EXPECT_NEAR(out[6]["m"].get<double>(), 0.1, 1e-12);
+  EXPECT_EQ(out[7]["frame"], 3);  // 0.031 s is nearest to frame 3 at 0.03 s
+
+  // screenshot: the frame with pressure colours on the left, the ImGui panel on the right
+  const json& s = out[8];
+  EXPECT_EQ(s["path"], shot);
+  const auto img = furrow::render::read_png(shot);
+  ASSERT_EQ(img.width, 1280);
+  ASSERT_EQ(img.height, 720);
+  const int x0 = s["panel_x0"].get<int>();
+  EXPECT_EQ(x0, 860);
+  expect_inspector_view(img, x0, "viridis");
+  // the same screenshot again is refused: nothing is overwritten
+  const auto again = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("screenshot " + shot + "\n")});
+  EXPECT_EQ(again.status, 1);
+  EXPECT_NE(again.err.find("script.txt:1:"), std::string::npos) << again.err;
+}
+
+TEST_F(InspectCli, BadScriptLinesNameFileLineAndWhatWasExpected) {
+  const StoredRun stored(dir_ / "run");
+  auto r = run({"inspect", (dir_ / "run").string(), "--headless", "--script",
+                script("field pressure\n\nprobe 0.1\nlength 0 0 1 1\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("script.txt:3: expected 'probe X Y', got 'probe 0.1'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");  // checked before anything runs
+  r = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("zoom 2\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("script.txt:1: expected one of field, frame, time, probe"), std::string::npos) << r.err;
+  r = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("field temperature\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("unknown field 'temperature'"), std::string::npos) << r.err;
+  // what the run does not hold: the line, and what it has
+  r = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("length 0 0 3 4\nframe 9\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.out).size(), 1u);
+  EXPECT_NE(r.err.find("script.txt:2: frame 9 is not stored"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("frames 0..3"), std::string::npos) << r.err;
+  r = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("field phi_d\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("script.txt:1: field 'phi_d' is not stored"), std::string::npos) << r.err;
+  // no --headless: a clear message, not a crash
+  r = run({"inspect", (dir_ / "run").string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--headless --script FILE"), std::string::npos) << r.err;
+}
+
+// A virtual X display for the window test: Xvfb on a display number of this process's own.
+struct Xvfb {
+  pid_t pid = -1;
+  int number = 0;
+  bool up = false;
+  Xvfb() {
+    number = 200 + int(::getpid() % 500);
+    pid = fork();
+    if (pid == 0) {
+      const std::string d = ":" + std::to_string(number);
+      freopen("/dev/null", "w", stderr);
+      execlp("Xvfb", "Xvfb", d.c_str(), "-screen", "0", "1600x900x24", "-nolisten", "tcp", (char*)nullptr);
+      _exit(127);
+    }
+    const std::string socket = "/tmp/.X11-unix/X" + std::to_string(number);
+    for (int k = 0; k < 100 && pid > 0 && !up; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      up = std::filesystem::exists(socket) && waitpid(pid, nullptr, WNOHANG) == 0;
+    }
+  }
+  ~Xvfb() {
+    if (pid > 0) {
+      kill(pid, SIGTERM);
+      waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+TEST_F(InspectCli, WindowUnderXvfbReplaysAScriptAndScreenshotsTheWindow) {
+  if (std::system("command -v Xvfb >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "Xvfb is not installed (apt-get install xvfb, as .ci/setup.sh does): no display to open the window on";
+  Xvfb x;
+  if (!x.up) GTEST_SKIP() << "Xvfb could not start on display :" << x.number;
+  const StoredRun stored(dir_ / "run");
+  const std::string shot = path("window.png");
+  setenv("DISPLAY", (":" + std::to_string(x.number)).c_str(), 1);
+  const auto r = run({"inspect", (dir_ / "run").string(), "--script",
+                      script("frame 1\nfield strain_rate\nscreenshot " + shot + "\n"), "--exit-after-script"});
+  unsetenv("DISPLAY");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<json> out = lines(r.out);
+  ASSERT_EQ(out.size(), 3u) << r.out;
+  EXPECT_EQ(out[2]["action"], "screenshot");
+  EXPECT_EQ(out[2]["frame"], 1);
+  // read back from the X server: the strain-rate field on the left, the panel on the right
+  const auto img = furrow::render::read_png(shot);
+  ASSERT_EQ(img.width, 1280);
+  ASSERT_EQ(img.height, 720);
+  const int x0 = out[2]["panel_x0"].get<int>();
+  expect_inspector_view(img, x0, "magma");
+}
+
+}  // namespace
