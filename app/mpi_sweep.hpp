@@ -42,7 +42,8 @@ class Job {
 
   // Runs every index of `todo` once, in that order, over the whole job: whichever rank is free
   // takes the next (rank 0 hands them out and runs them too). Alone, `threads_when_alone`
-  // runs at a time. `on_done` sees every Outcome, one at a time, on rank 0 only.
+  // runs at a time. `on_done` sees every Outcome, one at a time, on rank 0 only. Neither `run`
+  // nor `on_done` may throw (they run on threads of their own).
   void distribute(const std::vector<size_t>& todo, int threads_when_alone,
                   const std::function<Outcome(size_t)>& run, const std::function<void(const Outcome&)>& on_done);
 

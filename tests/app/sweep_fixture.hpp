@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "tests/app/cli_fixture.hpp"
@@ -34,6 +35,13 @@ inline const char* kTinyScene = R"({
   ],
   "outputs": {"average_window": {"from_m": 0.0085, "to_m": 0.0155}}
 })";
+
+// The same bed with the plate alone (what the study tests read).
+inline std::string tiny_plate_scene() {
+  auto j = nlohmann::json::parse(kTinyScene);
+  j["bodies"].erase(1);
+  return j.dump(2);
+}
 
 inline std::vector<std::string> split(const std::string& line, char sep) {
   std::vector<std::string> out(1);
@@ -130,10 +138,16 @@ class SweepCli : public CliFixture {
     if (rc != 0) c.pid = -1;
     return c;
   }
-  // Exit status (-1 when killed by a signal) and output.
-  Result finish(Child& c) {
+  // Exit status (-1 when killed by a signal) and output; a child still running after `timeout_s`
+  // (a hung mpirun) is killed.
+  Result finish(Child& c, double timeout_s = 300) {
     Result r;
-    if (c.pid > 0 && c.wait_status < 0) ::waitpid(c.pid, &c.wait_status, 0);
+    if (c.pid > 0 && c.wait_status < 0) wait_until([] { return false; }, timeout_s, &c);
+    if (c.pid > 0 && c.wait_status < 0) {
+      ADD_FAILURE() << "killed after " << timeout_s << " s: " << read_text(c.err);
+      ::kill(c.pid, SIGKILL);
+      ::waitpid(c.pid, &c.wait_status, 0);
+    }
     r.status = c.wait_status >= 0 && WIFEXITED(c.wait_status) ? WEXITSTATUS(c.wait_status) : -1;
     r.out = read_text(c.out);
     r.err = read_text(c.err);

@@ -12,12 +12,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using furrow::cli_test::Child;
-using furrow::cli_test::Csv;
-using furrow::cli_test::read_csv;
-using furrow::cli_test::read_text;
-using furrow::cli_test::Result;
-using furrow::cli_test::SweepCli;
+using namespace furrow::cli_test;
 
 // 2 plate widths x 3 rod depths
 const std::vector<std::string> kSixRuns = {"--vary", "bodies.plate.shape.size_m.0=0.02,0.03", "--vary",
@@ -166,7 +161,7 @@ TEST_F(SweepResume, ThreeMpiRanksWriteTheTableOfOneProcess) {
   for (const auto& r : sj["runs"]) ranks.insert(r["rank"].get<int>());
   EXPECT_GE(ranks.size(), 2u) << sj["runs"].dump();
   size_t progress_lines = 0;
-  for (const auto& line : furrow::cli_test::split(mpi.err, '\n')) progress_lines += line.rfind("[", 0) == 0;
+  for (const auto& line : split(mpi.err, '\n')) progress_lines += line.rfind("[", 0) == 0;
   EXPECT_EQ(progress_lines, 6u) << mpi.err;
 }
 
