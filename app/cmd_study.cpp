@@ -13,7 +13,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -22,6 +21,7 @@
 #include "app/calibration.hpp"
 #include "app/commands.hpp"
 #include "app/progress.hpp"
+#include "app/run_dirs.hpp"
 #include "app/study.hpp"
 #include "app/sweep.hpp"
 #include "engine/field_store.hpp"
@@ -39,53 +39,8 @@ namespace {
 volatile sig_atomic_t g_stop = 0;
 void on_stop(int) { g_stop = 1; }
 
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 bool is_dx_ladder(const sweep::Vary& v) {
   return v.keys.size() == 1 && (v.keys[0] == "domain.dx_m" || v.keys[0] == "/domain/dx_m");
-}
-
-// The scene text a rung's run directory must hold to count as that rung: threads do not change
-// results (runs are bit-identical for any thread count), so they are left out of the comparison.
-nlohmann::json comparable(Scene s) {
-  s.solver.threads = 0;
-  return scene_to_json(s);
-}
-
-// Whether `dir` holds a complete run of `scene`: "" if so, else why not ("absent" when missing).
-std::string run_matches(const fs::path& dir, const Scene& scene) {
-  if (!fs::exists(dir)) return "absent";
-  if (!fs::exists(dir / "run.json") || !fs::exists(dir / "scene.json")) return "it is not a complete run";
-  try {
-    ValidationOptions v;
-    v.allow_large = true;  // the rung itself was checked with the user's --yes
-    const Scene stored = parse_scene_text(read_text(dir / "scene.json"), (dir / "scene.json").string(), {}, v);
-    const auto patch = nlohmann::json::diff(comparable(stored), comparable(scene));
-    if (patch.empty()) return "";
-    std::string keys;
-    for (size_t i = 0; i < patch.size() && i < 3; ++i) keys += (i ? ", " : "") + patch[i].value("path", std::string("?"));
-    return "it holds a run of a different scene (differs at " + keys + (patch.size() > 3 ? ", ..." : "") + ")";
-  } catch (const std::exception& e) {
-    return std::string("its scene.json does not load: ") + e.what();
-  }
-}
-
-// Removes run directories that children killed part-way left behind (their process is gone).
-void remove_stale_partials(const fs::path& dir) {
-  if (!fs::exists(dir)) return;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    const auto at = name.rfind(".partial-");
-    if (at == std::string::npos) continue;
-    const long pid = std::strtol(name.c_str() + at + 9, nullptr, 10);
-    if (pid > 0 && ::kill(pid_t(pid), 0) == 0) continue;  // still running (another study)
-    fs::remove_all(e.path());
-  }
 }
 
 struct Job {
@@ -153,11 +108,10 @@ int study_main(const Parsed& p) {
   // a rung whose directory holds something else is not overwritten: say so before running anything
   std::vector<std::string> conflicts;
   for (size_t r = 0; r < rungs.size(); ++r) {
-    const std::string why = run_matches(out_dir / rungs[r].dir, scenes[r]);
-    if (why.empty()) rungs[r].reused = true;
-    else if (why != "absent" && fs::exists(out_dir / rungs[r].dir / "run.json"))
-      conflicts.push_back((out_dir / rungs[r].dir).string() + ": " + why);
-    else if (why != "absent")
+    const RunDirMatch m = match_run_dir(out_dir / rungs[r].dir, scenes[r]);
+    if (m.state == RunDirState::same_scene) rungs[r].reused = true;
+    else if (m.state == RunDirState::other_scene) conflicts.push_back((out_dir / rungs[r].dir).string() + ": " + m.why);
+    else if (m.state == RunDirState::incomplete)
       fs::remove_all(out_dir / rungs[r].dir);  // an incomplete rung directory holds no finished result
   }
   if (!conflicts.empty()) {
@@ -185,12 +139,7 @@ int study_main(const Parsed& p) {
 
   auto collect = [&](size_t r) {
     auto& g = rungs[r];
-    const fs::path dir = out_dir / g.dir;
-    const auto j = nlohmann::json::parse(read_text(dir / "run.json"));
-    RunSummary s;
-    s.run_json = j;
-    s.out_dir = dir.string();
-    const auto metrics = sweep::run_metrics(scenes[r], s, sweep::read_forces_csv((dir / "forces.csv").string(), scenes[r]));
+    const auto [j, metrics] = read_finished_run(out_dir / g.dir, scenes[r]);
     std::string why;
     g.value = study::extract(q, metrics, j, body, &why);
     g.error = std::isfinite(g.value) ? "" : why;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "app/cli.hpp"
+#include "app/mpi_sweep.hpp"
 
 using namespace furrow;
 
@@ -28,7 +29,7 @@ int main(int argc, char** argv) {
     return args.empty() ? 2 : 0;
   }
   if (args[0] == "--version") {
-    std::cout << "furrow " << FURROW_VERSION << "\n";
+    std::cout << "furrow " << FURROW_VERSION << "\nMPI: " << cli::mpi::build_text() << "\n";
     return 0;
   }
   const cli::Command* cmd = nullptr;

@@ -426,8 +426,10 @@ std::vector<Column> columns(const std::vector<Vary>& varies, const std::vector<S
   for (size_t k = 0; k < varies.size(); ++k)
     cols.push_back({varies[k].column, "swept value (--vary " + varies[k].spec + "); unit as the key's suffix says",
                     [k](const SweepRow& r) { return k < r.values.size() ? r.values[k] : std::string(); }});
-  cols.push_back({"status", "ok, or failed (the error is in sweep.json)",
+  cols.push_back({"status", "ok, or failed (why: the error column)",
                   [](const SweepRow& r) { return std::string(r.ok ? "ok" : "failed"); }});
+  cols.push_back({"error", "why the run failed: an invalid scene, a solver error, a missing result",
+                  [](const SweepRow& r) { return r.ok ? std::string() : r.error; }});
   cols.push_back({"wall_s", "wall time of the run (s)", [](const SweepRow& r) { return num_cell(r.wall_s); }});
   auto metric = [&](const std::string& name, const std::string& meaning, double RunMetrics::*field) {
     cols.push_back({name, meaning, [field](const SweepRow& r) { return r.ok ? num_cell(r.metrics.*field) : ""; }});

@@ -27,6 +27,20 @@ size_t peak_resident_bytes() {
   return size_t(u.ru_maxrss) * 1024;  // Linux reports KiB
 }
 
+nlohmann::json result_defining_json(const Scene& scene) {
+  Scene s = scene;
+  s.solver.threads = 0;
+  return scene_to_json(s);
+}
+
+std::string scene_hash(const Scene& scene) {
+  uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis and prime
+  for (const unsigned char c : result_defining_json(scene).dump()) h = (h ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
 namespace {
 
 // Averages forces over output intervals and writes one CSV row per body per interval.
@@ -230,6 +244,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   const double psteps = double(sim.particles().size()) * double(sim.step_count());
   auto& j = summary.run_json;
   j["scene"] = scene.name;
+  j["scene_hash"] = scene_hash(scene);
   j["particles"] = sim.particles().size();
   j["grid_nodes"] = sim.grid().node.size();
   j["steps"] = sim.step_count();

@@ -46,6 +46,13 @@ struct RunSummary {
 // Throws std::runtime_error when out_dir exists and !force, or when an output cannot be written.
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
+// The resolved scene without what cannot change a run's results (solver.threads: runs are
+// bit-identical for any thread count): two runs are of the same scene when these are equal.
+nlohmann::json result_defining_json(const Scene& scene);
+// FNV-1a 64 of result_defining_json(scene).dump() as 16 hex digits; run.json's "scene_hash", so a
+// finished run directory says which scene it completed without reparsing its scene.json.
+std::string scene_hash(const Scene& scene);
+
 // Peak resident memory of this process (bytes).
 size_t peak_resident_bytes();
 

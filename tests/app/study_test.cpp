@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "app/study.hpp"
-#include "tests/app/cli_fixture.hpp"
+#include "tests/app/sweep_fixture.hpp"
 
 namespace fs = std::filesystem;
 
@@ -104,21 +104,6 @@ TEST(StudyPrediction, ALineInParticleStepsThroughTheFinishedRungs) {
 
 // ---- the real binary ----------------------------------------------------------------------------
 
-// A 0.1 x 0.05 m bed; a 20 mm plate pushed 15.5 mm down from 0.5 mm above it (as in sweep_test).
-const char* kTinyScene = R"({
-  "schema_version": 1,
-  "name": "tiny",
-  "domain": {"width_m": 0.1, "height_m": 0.07, "dx_m": 0.005},
-  "solver": {"end_time_s": 1.0, "end_displacement_m": 0.0155, "threads": 1},
-  "materials": [{"name": "sand", "model": "ndpm", "grain_density_kg_m3": 2500, "phi_c": 0.6, "mu_s": 0.4}],
-  "beds": [{"material": "sand", "min_m": [0, 0], "max_m": [0.1, 0.05], "packing_fraction": 0.58}],
-  "bodies": [
-    {"name": "plate", "shape": {"type": "box", "size_m": [0.02, 0.01]}, "start_m": [0.05, 0.0555],
-     "motion": {"type": "constant_velocity", "velocity_m_s": [0, -0.1]}}
-  ],
-  "outputs": {"average_window": {"from_m": 0.0085, "to_m": 0.0155}}
-})";
-
 struct Table {
   std::vector<std::string> header;
   std::vector<std::map<std::string, std::string>> rows;
@@ -152,7 +137,7 @@ class StudyCli : public furrow::cli_test::CliFixture {
   StudyCli() : CliFixture("furrow_study_") {}
   void SetUp() override {
     CliFixture::SetUp();
-    std::ofstream(path("tiny.json")) << kTinyScene;
+    std::ofstream(path("tiny.json")) << furrow::cli_test::tiny_plate_scene();
   }
 };
 

@@ -2,7 +2,7 @@
 // sweep.csv (columns, units, normalizations), sweep.json, sweep.png, and its errors.
 #include <gtest/gtest.h>
 
-#include "tests/app/cli_fixture.hpp"
+#include "tests/app/sweep_fixture.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,80 +18,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using furrow::cli_test::Csv;
 using furrow::cli_test::Result;
+using furrow::cli_test::SweepCli;
+using furrow::cli_test::read_csv;
 using furrow::cli_test::read_text;
-namespace cli_test = furrow::cli_test;
-
-// A 0.1 x 0.05 m bed at dx 5 mm (about 800 particles): a plate pushed down 15 mm from 0.5 mm above
-// the surface and a rod dragged sideways; each run takes well under a second.
-const char* kTinyScene = R"({
-  "schema_version": 1,
-  "name": "tiny",
-  "domain": {"width_m": 0.1, "height_m": 0.07, "dx_m": 0.005},
-  "solver": {"end_time_s": 1.0, "end_displacement_m": 0.0155, "threads": 1},
-  "materials": [{"name": "sand", "model": "ndpm", "grain_density_kg_m3": 2500, "phi_c": 0.6, "mu_s": 0.4}],
-  "beds": [{"material": "sand", "min_m": [0, 0], "max_m": [0.1, 0.05], "packing_fraction": 0.58}],
-  "bodies": [
-    {"name": "plate", "shape": {"type": "box", "size_m": [0.02, 0.01]}, "start_m": [0.05, 0.0555],
-     "motion": {"type": "constant_velocity", "velocity_m_s": [0, -0.1]}},
-    {"name": "rod", "shape": {"type": "circle", "radius_m": 0.005}, "start_m": [0.015, 0.03],
-     "motion": {"type": "constant_velocity", "velocity_m_s": [0.05, 0]}}
-  ],
-  "outputs": {"average_window": {"from_m": 0.0085, "to_m": 0.0155}}
-})";
-
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out(1);
-  for (char c : line) {
-    if (c == sep) out.emplace_back();
-    else out.back() += c;
-  }
-  return out;
-}
-
-struct Csv {
-  std::vector<std::string> header;
-  std::vector<std::map<std::string, std::string>> rows;
-  double num(size_t r, const std::string& col) const {
-    auto it = rows.at(r).find(col);
-    if (it == rows.at(r).end()) ADD_FAILURE() << "no column " << col;
-    return it == rows.at(r).end() || it->second.empty() ? NAN : std::stod(it->second);
-  }
-};
-
-Csv read_csv(const fs::path& p) {
-  std::istringstream in(read_text(p));
-  Csv c;
-  std::string line;
-  std::getline(in, line);
-  c.header = split(line, ',');
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    const auto cells = split(line, ',');
-    EXPECT_EQ(cells.size(), c.header.size()) << line;
-    std::map<std::string, std::string> row;
-    for (size_t k = 0; k < std::min(cells.size(), c.header.size()); ++k) row[c.header[k]] = cells[k];
-    c.rows.push_back(row);
-  }
-  return c;
-}
-
-class SweepCli : public cli_test::CliFixture {
- protected:
-  SweepCli() : CliFixture("furrow_sweep_cli_") {}
-  void SetUp() override {
-    CliFixture::SetUp();
-    std::ofstream(dir_ / "tiny.json") << kTinyScene;
-  }
-  // Nothing but the scene and the captured output in the test directory.
-  void expect_nothing_written() const {
-    for (const auto& e : fs::directory_iterator(dir_)) {
-      const std::string n = e.path().filename().string();
-      EXPECT_TRUE(n == "tiny.json" || n == "stdout" || n == "stderr") << "unexpected " << n;
-    }
-  }
-
-};
+using furrow::cli_test::split;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -139,7 +71,7 @@ TEST_F(SweepCli, TwoByTwoWritesFourRunsAndATableWithUnits) {
   EXPECT_EQ(csv.header.at(2), "bodies.rod.start_m.1");
   for (size_t k = 3; k < csv.header.size(); ++k) {
     const std::string& h = csv.header[k];
-    const bool unit = h == "status" || h.find("_m") != std::string::npos || h.find("_s") != std::string::npos ||
+    const bool unit = h == "status" || h == "error" || h.find("_m") != std::string::npos || h.find("_s") != std::string::npos ||
                       h.find("_N_per_m") != std::string::npos || h.find("_kg_m3") != std::string::npos ||
                       h.find("_nondim") != std::string::npos;
     EXPECT_TRUE(unit) << "column without a unit: " << h;
@@ -208,12 +140,14 @@ TEST_F(SweepCli, UnknownKeyNamesTheNearestKeysAndWritesNothing) {
   expect_nothing_written();
 }
 
-TEST_F(SweepCli, InvalidValueNamesTheVaryAndWritesNothing) {
-  // the second value is out of range: found before the first run starts
-  const Result r = run({"sweep", path("tiny.json"), "--vary", "domain.dx_m=0.005,0", "--out", path("sw")});
+TEST_F(SweepCli, NoValidValueNamesTheVaryAndWritesNothing) {
+  // every value is out of range: found before anything runs (one invalid value among valid ones
+  // is a failed row instead: sweep_resume_test.cpp)
+  const Result r = run({"sweep", path("tiny.json"), "--vary", "domain.dx_m=-0.005,0", "--out", path("sw")});
   EXPECT_EQ(r.status, 1);
-  EXPECT_NE(r.err.find("/domain/dx_m"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("set by --vary domain.dx_m=0.005,0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/domain/dx_m: got -0.005"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/domain/dx_m: got 0,"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("set by --vary domain.dx_m=-0.005,0"), std::string::npos) << r.err;
   expect_nothing_written();
 }
 
