@@ -43,6 +43,13 @@ std::string describe_run(const sweep::SweepRow& r) {
       s += buf;
     }
   }
+  if (r.metrics.collapse) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%sa %.3g: runout (Lf - L0)/L0 %.3g, Hf/H0 %.3g%s", s.empty() ? "" : ", ",
+                  r.metrics.aspect_ratio, r.metrics.runout_relative, r.metrics.final_height_relative,
+                  r.metrics.settled ? "" : " (still moving)");
+    s += buf;
+  }
   return s;
 }
 
@@ -290,10 +297,10 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
     if (quiet) return;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double eta = elapsed / double(done) * double(d.todo.size() - done);
+    const std::string what = row.ok ? describe_run(row) : row.error;
     std::fprintf(stderr, "[%zu/%zu] %s: %s in %.1f s wall%s%s; elapsed %s, sweep ETA %s\n", done, d.todo.size(),
-                 row.dir.c_str(), row.ok ? "done" : "FAILED", row.wall_s, row.ok ? ", " : ": ",
-                 row.ok ? describe_run(row).c_str() : row.error.c_str(), format_duration(elapsed).c_str(),
-                 format_duration(eta).c_str());
+                 row.dir.c_str(), row.ok ? "done" : "FAILED", row.wall_s, what.empty() ? "" : row.ok ? ", " : ": ",
+                 what.c_str(), format_duration(elapsed).c_str(), format_duration(eta).c_str());
   };
   job.distribute(d.todo, jobs, run, on_done);
   if (!root) return 0;

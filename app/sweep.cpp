@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "engine/analysis.hpp"
 #include "engine/scene_io.hpp"
 
 namespace furrow::sweep {
@@ -400,6 +401,26 @@ RunMetrics run_metrics(const Scene& scene, const RunSummary& summary,
     if (bm.moving && body.shape.kind == Shape::Kind::Box) m.total_mean_drag_N_per_m += bm.mean_drag_N_per_m;
     m.bodies.push_back(bm);
   }
+  const auto c = summary.run_json.find("collapse");
+  if (c != summary.run_json.end() && c->is_object()) {
+    auto number = [&](const char* key) { return c->contains(key) && (*c)[key].is_number() ? (*c)[key].get<double>() : kNaN; };
+    m.collapse = true;
+    m.settled = c->value("settled", false);
+    m.aspect_ratio = number("aspect_ratio");
+    m.runout_relative = number("runout_relative");
+    m.final_height_relative = number("final_height_relative");
+    const CollapseGeometry g = collapse_geometry(scene);
+    const double L0 = number("L0_m");
+    if (c->contains("final_surface") && std::isfinite(L0)) {
+      const auto& fs = (*c)["final_surface"];
+      const auto xs = fs.value("x_m", std::vector<double>{}), hs = fs.value("height_m", std::vector<double>{});
+      for (size_t i = 0; i < std::min(xs.size(), hs.size()); ++i) {
+        const double d = xs[i] - g.back_x_m;
+        m.surface_x_over_L0.push_back((g.side < 0 ? -d : g.side > 0 ? d : std::abs(d)) / L0);
+        m.surface_height_over_L0.push_back(hs[i] / L0);
+      }
+    }
+  }
   return m;
 }
 
@@ -448,6 +469,17 @@ std::vector<Column> columns(const std::vector<Vary>& varies, const std::vector<S
       if (std::find(names.begin(), names.end(), b.name) == names.end()) names.push_back(b.name);
       any_box |= b.moving && b.kind == "box";
     }
+  bool any_collapse = false;
+  for (const auto& r : rows) any_collapse |= r.metrics.collapse;
+  if (any_collapse) {
+    metric("aspect_ratio_nondim", "released column: a = H0 / L0 (beds' extent; L0 a half-width when both sides are free)",
+           &RunMetrics::aspect_ratio);
+    metric("runout_nondim", "released column: (Lf - L0) / L0, Lf the final front (run.json collapse)",
+           &RunMetrics::runout_relative);
+    metric("final_height_nondim", "released column: Hf / H0, Hf the final highest point", &RunMetrics::final_height_relative);
+    cols.push_back({"settled", "released column: the front moved less than 1% of L0 over the last tenth of the run",
+                    [](const SweepRow& r) { return r.ok && r.metrics.collapse ? std::string(r.metrics.settled ? "yes" : "no") : ""; }});
+  }
   if (any_box) {
     metric("L_avg_m", "mean width of the moving boxes (plates), L_avg (m)", &RunMetrics::L_avg_m);
     metric("z_m", "depth of the moving boxes' bottoms below the bed surface at the middle of the averaging window (m)",

@@ -3,6 +3,7 @@
 // itself (parallel runs, progress, atomic output) is app/cmd_sweep.cpp; the figure is
 // app/sweep_plot.cpp.
 #pragma once
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -87,6 +88,11 @@ struct RunMetrics {
   double gap_m = 0.0;             // inner-edge gap of the first two moving boxes at the start (NaN: < 2)
   double total_mean_drag_N_per_m = 0.0;  // sum over moving boxes (NaN: none)
   double total_F0_N_per_m = 0.0;  // rho_d g z L_avg w
+  // a released column (run.json "collapse"): H0 / L0, (Lf - L0) / L0, Hf / H0, whether its front
+  // had stopped, and the final surface in units of L0 (NaN / empty for other runs)
+  bool collapse = false, settled = false;
+  double aspect_ratio = std::nan(""), runout_relative = std::nan(""), final_height_relative = std::nan("");
+  std::vector<double> surface_x_over_L0, surface_height_over_L0;
 };
 
 // Initial peak of a drag trace: the trace is smoothed by a moving average over `smooth_m` of

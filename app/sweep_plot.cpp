@@ -155,7 +155,65 @@ SweepFigure sweep_figure(const std::string& scene_name, const std::vector<Vary>&
   const RowValue gap = [](const SweepRow& r) { return r.metrics.gap_m; };
   const RowValue L_avg = [](const SweepRow& r) { return r.metrics.L_avg_m; };
 
-  if (!lead.empty() && lead_circle && varies_over_rows(depth)) {
+  const RowValue aspect = [](const SweepRow& r) { return r.metrics.aspect_ratio; };
+  bool all_collapse = !rows.empty();
+  for (const SweepRow* r : rows) all_collapse = all_collapse && r->metrics.collapse;
+
+  if (all_collapse && varies_over_rows(aspect)) {
+    // ---- released columns: runout vs aspect ratio against the experiments' laws ----
+    out.kind = "collapse_runout";
+    fig.title = scene_name + ": column collapse, runout vs aspect ratio";
+    const RowValue runout = [](const SweepRow& r) { return r.metrics.runout_relative; };
+    const auto cs = curves(varies, rows, drivers(varies, rows, {aspect}), aspect);
+    render::PlotPanel a, b;
+    a.title = "runout";
+    a.x_label = "a = H0 / L0";
+    a.y_label = "(Lf - L0) / L0";
+    a.log_x = a.log_y = true;
+    a.legend_top = false;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (const SweepRow* r : rows) lo = std::min(lo, aspect(*r)), hi = std::max(hi, aspect(*r));
+    // quasi-2D channel experiments in their linear regime (a up to about 2-3)
+    for (auto [label, k] : {std::pair{"1.2 a (Lube et al. 2005)", 1.2}, std::pair{"1.8 a (Lajeunesse et al. 2005)", 1.8}}) {
+      render::PlotSeries law;
+      law.label = label;
+      law.dashed = true;
+      law.markers = false;
+      law.color = 4 + int(k > 1.5);  // the simulation curves take 0..3
+      for (double x : {lo, hi}) law.x.push_back(x), law.y.push_back(k * x);
+      a.series.push_back(law);
+    }
+    for (size_t c = 0; c < cs.size(); ++c) {
+      a.series.push_back(series(cs[c].label.empty() ? "simulation" : cs[c].label, cs[c].rows, aspect, runout, int(c)));
+      const LineFit f = fit_power_law(a.series.back().x, a.series.back().y);
+      if (f.n >= 2 && c < 4)
+        a.notes.push_back((cs.size() > 1 ? "[" + std::to_string(c + 1) + "] " : std::string()) + "runout = " +
+                          fmt("%.3g", std::exp(f.intercept)) + " a^" + fmt("%.2f", f.slope));
+    }
+    for (const SweepRow* r : rows)
+      if (!r->metrics.settled) {
+        a.notes.push_back("not settled at the end: " + r->dir);
+        break;
+      }
+    // the final surfaces of the first curve, one per a
+    b.title = "final deposit" + (cs.empty() || cs[0].label.empty() ? std::string() : " (" + cs[0].label + ")");
+    b.x_label = "x / L0 (from the back wall)";
+    b.y_label = "h / L0";
+    b.y_from_zero = true;
+    b.legend_top = true;
+    if (!cs.empty())
+      for (size_t i = 0; i < cs[0].rows.size(); ++i) {
+        const RunMetrics& m = cs[0].rows[i]->metrics;
+        render::PlotSeries p;
+        p.label = "a = " + fmt("%.3g", m.aspect_ratio);
+        p.markers = false;
+        p.color = int(i);
+        p.x = m.surface_x_over_L0;
+        p.y = m.surface_height_over_L0;
+        b.series.push_back(p);
+      }
+    fig.panels = {a, b};
+  } else if (!lead.empty() && lead_circle && varies_over_rows(depth)) {
     // ---- paper case 1: drag and lift vs |z|/D ----
     out.kind = "drag_lift_vs_depth";
     fig.title = scene_name + ": drag and lift on " + lead + " vs depth";

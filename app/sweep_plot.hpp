@@ -5,6 +5,9 @@
 //                       vs L on log-log axes with fitted power-law exponents (paper case 2, single)
 //   pair_separation     two or more moving boxes whose gap varies: mean drag per plate over
 //                       rho_d g z L_avg w vs s/L_avg, one curve per L_avg (paper case 2, pairs)
+//   collapse_runout     released columns (run.json "collapse") whose aspect ratio varies: runout
+//                       (Lf - L0)/L0 vs a on log-log axes with the quasi-2D experiments' linear laws,
+//                       and the final deposits' surfaces
 //   generic             the first swept key on x, the mean drag and lift of each moving body on y
 // Rows that differ in other swept keys become separate curves.
 #pragma once

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "engine/scene_io.hpp"
@@ -492,7 +493,28 @@ CollapseGeometry collapse_geometry(const Scene& scene) {
   g.L0_m = g.side == 0 ? 0.5 * (x1 - x0) : x1 - x0;
   g.floor_y_m = y0;
   g.H0_m = y1 - y0;
+  g.cell_m = scene.domain.dx_m;
+  g.point_half_m = 0.5 * scene.domain.dx_m / std::max(1, scene.solver.particles_per_cell_1d);
   return g;
+}
+
+std::vector<std::pair<double, double>> collapse_surface(const ParticleView& p, const CollapseGeometry& g) {
+  std::map<long, std::vector<std::pair<double, double>>> columns;  // cell column -> (bottom, top) of its points
+  for (size_t i = 0; i < p.count; ++i) {
+    const double y = p.y_m[i] - g.floor_y_m;
+    columns[long(std::floor(p.x_m[i] / g.cell_m))].emplace_back(y - g.point_half_m, y + g.point_half_m);
+  }
+  std::vector<std::pair<double, double>> surface;
+  for (auto& [c, points] : columns) {
+    std::sort(points.begin(), points.end());
+    double top = -std::numeric_limits<double>::infinity();
+    for (const auto& [bottom, point_top] : points) {
+      if (std::isfinite(top) && bottom > top + 2.0 * g.cell_m) break;  // a grain in flight above the deposit
+      top = std::max(top, point_top);
+    }
+    surface.emplace_back((double(c) + 0.5) * g.cell_m, top);
+  }
+  return surface;
 }
 
 CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g, double t_s) {
@@ -500,18 +522,15 @@ CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g
   s.t_s = t_s;
   if (p.count == 0) return s;
   std::vector<double> reach(p.count);
-  double top = -std::numeric_limits<double>::infinity(), half_sum = 0.0;
   for (size_t i = 0; i < p.count; ++i) {
-    const double half = 0.5 * std::sqrt(p.volume_m2[i]);
-    half_sum += half;
     const double dx = p.x_m[i] - g.back_x_m;
     reach[i] = g.side > 0 ? dx : g.side < 0 ? -dx : std::abs(dx);
-    top = std::max(top, p.y_m[i] + half);
   }
   const size_t k = size_t(0.995 * double(p.count - 1));
   std::nth_element(reach.begin(), reach.begin() + std::ptrdiff_t(k), reach.end());
-  s.front_m = reach[k] + half_sum / double(p.count);
-  s.height_m = top - g.floor_y_m;
+  s.front_m = reach[k] + g.point_half_m;
+  s.height_m = 0.0;
+  for (const auto& [x, h] : collapse_surface(p, g)) s.height_m = std::max(s.height_m, h);
   return s;
 }
 
@@ -521,9 +540,15 @@ CollapseAnalysis::CollapseAnalysis(const Scene& scene) : g_(collapse_geometry(sc
 
 void CollapseAnalysis::add_step(double t_s, const ParticleView& p, bool last) {
   if (!g_.active) return;
-  if (last ? !samples_.empty() && samples_.back().t_s == t_s : t_s < next_s_ - 1e-12) return;
-  samples_.push_back(measure_collapse(p, g_, t_s));
-  next_s_ = t_s + interval_s_;
+  const bool sampled_now = !samples_.empty() && samples_.back().t_s == t_s;
+  if (last ? !sampled_now : t_s >= next_s_ - 1e-12) {
+    samples_.push_back(measure_collapse(p, g_, t_s));
+    next_s_ = t_s + interval_s_;
+  }
+  if (!last) return;
+  profile_x_m_.clear();
+  profile_height_m_.clear();
+  for (const auto& [x, h] : collapse_surface(p, g_)) profile_x_m_.push_back(x), profile_height_m_.push_back(h);
 }
 
 nlohmann::json CollapseAnalysis::to_json() const {
@@ -540,8 +565,9 @@ nlohmann::json CollapseAnalysis::to_json() const {
   for (const auto& s : samples_) t.push_back(s.t_s), f.push_back(s.front_m), h.push_back(s.height_m);
   return {{"definition",
            "front: distance from the column's back wall (both sides free: its centre line) beyond which "
-           "0.5% of the material points lie, plus half a point's size; height: highest point top above "
-           "the floor; L0, H0: the beds' extent; runout (Lf - L0) / L0 and Hf / H0 at the end"},
+           "0.5% of the material points lie, plus half their seeded spacing; height: highest top of the "
+           "material resting on the floor (per cell column, up through gaps under two cells: grains "
+           "in flight do not count); L0, H0: the beds' extent; runout (Lf - L0) / L0 and Hf / H0 at the end"},
           {"spreads", g_.side > 0 ? "+x" : g_.side < 0 ? "-x" : "both ways"},
           {"L0_m", g_.L0_m},
           {"H0_m", g_.H0_m},
@@ -553,7 +579,8 @@ nlohmann::json CollapseAnalysis::to_json() const {
           {"settled", std::abs(last.front_m - front_then) < 0.01 * g_.L0_m},
           {"t_s", t},
           {"front_m", f},
-          {"height_m", h}};
+          {"height_m", h},
+          {"final_surface", {{"x_m", profile_x_m_}, {"height_m", profile_height_m_}}}};
 }
 
 }  // namespace furrow

@@ -152,17 +152,27 @@ double slip_line_apex_angle_deg(double mu);
 // wall its beds touch (both sides free: it spreads both ways and lengths are half-widths from its
 // centre line); L0 and H0 are the beds' extent. At each sample:
 //   front  = distance from the back to the point beyond which 0.5% of the material points lie,
-//            plus half a point's size (a few grains thrown ahead do not count, as in experiments
+//            plus half a point's seeded spacing (a few grains thrown ahead do not count, as in experiments
 //            that read the front off the continuous deposit);
-//   height = highest point top (centre + half its size) above the floor.
+//   height = highest top of the material resting on the floor: in each cell column, points are
+//            followed up from the floor while the gap to the next is under two cells (a loose
+//            deposit holds voids of a cell; a grain in flight above it does not count).
 // Runout (Lf - L0) / L0 and Hf / H0 from the last sample; "settled" when the front moved less than
-// 1% of L0 over the last tenth of the run.
+// 1% of L0 over the last tenth of the run; the final deposit's surface as the highest point top in
+// each cell column.
 struct CollapseGeometry {
   bool active = false;
   int side = 0;  // +1: spreads toward +x from a wall at back_x_m; -1: toward -x; 0: both ways
   double back_x_m = 0.0, floor_y_m = 0.0, L0_m = 0.0, H0_m = 0.0;
+  double cell_m = 0.0;        // column width of the surface
+  double point_half_m = 0.0;  // half the points' seeded spacing: their extent (a dilute point's volume
+                              // keeps growing in flight, so its current size would not do)
 };
 CollapseGeometry collapse_geometry(const Scene& scene);
+
+// The material's surface: (column centre x, height of the material resting on the floor) per cell
+// column that holds points, left to right.
+std::vector<std::pair<double, double>> collapse_surface(const ParticleView& p, const CollapseGeometry& g);
 
 struct CollapseSample {
   double t_s = 0.0, front_m = 0.0, height_m = 0.0;
@@ -183,6 +193,7 @@ class CollapseAnalysis {
   CollapseGeometry g_;
   double interval_s_ = 0.0, next_s_ = 0.0;
   std::vector<CollapseSample> samples_;
+  std::vector<double> profile_x_m_, profile_height_m_;  // the last sample's surface, one per cell column
 };
 
 // ---------------------------------------------------------------- run.json hook

@@ -234,3 +234,33 @@ TEST_F(SweepCli, FigureFollowsWhatWasSwept) {
     EXPECT_TRUE(fs::exists(out + "/sweep.png")) << c.args[1];
   }
 }
+
+// Released columns of two aspect ratios (the collapse template, coarse): sweep.csv carries a, the
+// runout and Hf/H0 of each, a taller column runs further and ends lower relative to its height,
+// and the figure is runout against a.
+TEST_F(SweepCli, CollapseSweepTabulatesRunoutAgainstAspectRatio) {
+  const std::string out = path("collapse");
+  const Result r = run({"sweep", std::string(FURROW_SOURCE_DIR) + "/scenes/column_collapse.json", "--out", out,
+                        "--vary", "beds.0.max_m=[0.1,0.05],[0.1,0.1]", "--set", "domain.dx_m=0.01", "--set",
+                        "domain.width_m=0.4", "--set", "solver.end_time_s=0.4", "--set", "outputs.fields=[]", "--set",
+                        "outputs.movies=[]", "--no-paraview", "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Csv csv = read_csv(out + "/sweep.csv");
+  ASSERT_EQ(csv.rows.size(), 2u);
+  std::map<double, std::pair<double, double>> by_a;  // a -> runout, Hf/H0
+  for (const auto& row : csv.rows)
+    by_a[std::stod(row.at("aspect_ratio_nondim"))] = {std::stod(row.at("runout_nondim")),
+                                                       std::stod(row.at("final_height_nondim"))};
+  ASSERT_EQ(by_a.size(), 2u);
+  EXPECT_DOUBLE_EQ(by_a.begin()->first, 0.5);
+  EXPECT_DOUBLE_EQ(by_a.rbegin()->first, 1.0);
+  const auto [low_runout, low_height] = by_a.begin()->second;
+  const auto [tall_runout, tall_height] = by_a.rbegin()->second;
+  EXPECT_GT(low_runout, 0.2);
+  EXPECT_GT(tall_runout, 1.3 * low_runout);
+  EXPECT_LT(tall_height, low_height);
+  EXPECT_LE(low_height, 1.0 + 1e-3);
+  const auto sj = nlohmann::json::parse(read_text(out + "/sweep.json"));
+  EXPECT_EQ(sj["figure"], "collapse_runout");
+  EXPECT_TRUE(fs::exists(out + "/sweep.png"));
+}

@@ -128,6 +128,14 @@ TEST(CollapseAnalysis, RunJsonHasTheRunoutSeries) {
   // the geostatic start is elastically compressed: rho g H0^2 / (2 E) ~ 1.5e-6 m
   EXPECT_NEAR(c.at("height_m")[0].get<double>(), 0.1, 1e-5);
   EXPECT_DOUBLE_EQ(c.at("aspect_ratio").get<double>(), 1.0);
+  // the final surface: one point per cell column holding material, its highest the final height
+  const auto& xs = c.at("final_surface").at("x_m");
+  const auto& hs = c.at("final_surface").at("height_m");
+  ASSERT_EQ(xs.size(), hs.size());
+  ASSERT_GE(xs.size(), 10u);  // the column was 10 cells wide
+  double top = 0.0;
+  for (const auto& h : hs) top = std::max(top, h.get<double>());
+  EXPECT_DOUBLE_EQ(top, c.at("final_height_m").get<double>());
   std::ifstream in(dir / "run.json");
   EXPECT_EQ(nlohmann::json::parse(in).at("collapse"), c);
   std::filesystem::remove_all(dir);
