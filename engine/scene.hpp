@@ -77,8 +77,18 @@ struct Wall {
   double friction = 0.0;
 };
 
+// The two walls parallel to the simulated plane of a quasi-2D channel (glass plates gap_m apart):
+// Coulomb friction on them, 2 mu |sigma_zz| / gap per unit volume against the in-plane motion.
+// Absent (gap_m 0): plane strain, no such walls.
+struct FrontBackWalls {
+  double gap_m = 0.0;
+  double friction = 0.0;
+  bool present() const { return gap_m > 0.0; }
+};
+
 struct Walls {
   Wall left, right, bottom, top{Wall::Kind::Open, 0.0};
+  FrontBackWalls front_back;
 };
 
 struct Effects {

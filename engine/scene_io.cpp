@@ -446,6 +446,12 @@ Walls read_walls(const Ctx& c, const json* j) {
   w.right = read_wall(c, o.opt("right"), o.at("right"), w.right);
   w.bottom = read_wall(c, o.opt("bottom"), o.at("bottom"), w.bottom);
   w.top = read_wall(c, o.opt("top"), o.at("top"), w.top);
+  if (const json* fb = o.opt("front_back"); fb && !fb->is_null()) {
+    Obj f(c, *fb, o.at("front_back"), kFrontBackKeys);
+    w.front_back.gap_m = num(f, "gap_m", Range{0.0, 10.0, true, false}, "m");
+    w.front_back.friction = num(f, "friction", kFriction, "");
+    f.finish();
+  }
   o.finish();
   return w;
 }

@@ -112,7 +112,8 @@ const KeyList kUnionKeys = {"type", "parts"};
 const KeyList kConstantMotionKeys = {"type", "velocity_m_s"};
 const KeyList kPathMotionKeys = {"type", "knots"};
 const KeyList kKnotKeys = {"t_s", "velocity_m_s"};
-const KeyList kWallsKeys = {"left", "right", "bottom", "top"};
+const KeyList kWallsKeys = {"left", "right", "bottom", "top", "front_back"};
+const KeyList kFrontBackKeys = {"gap_m", "friction"};
 const KeyList kFrictionWallKeys = {"type", "friction"};
 const KeyList kPlainWallKeys = {"type"};
 const KeyList kEffectsKeys = {"gravity", "gravity_m_s2", "dilatancy", "separation", "body_friction",
@@ -264,6 +265,7 @@ std::vector<std::string> schema_keys(const json& root, const std::string& pointe
     if (is(0, "materials")) return material_keys(here);
     if (is(0, "beds")) return kBedKeys;
     if (is(0, "bodies")) return kBodyKeys;
+    if (is(0, "walls") && is(1, "front_back")) return kFrontBackKeys;
     if (is(0, "walls")) return wall_keys(here);
     if (is(0, "outputs") && is(1, "average_window")) return kWindowKeys;
     return {};

@@ -125,6 +125,14 @@ J to_json(const Scene& s) {
   walls["right"] = wall_json<J>(s.walls.right);
   walls["bottom"] = wall_json<J>(s.walls.bottom);
   walls["top"] = wall_json<J>(s.walls.top);
+  if (s.walls.front_back.present()) {
+    J fb = J::object();
+    fb["gap_m"] = s.walls.front_back.gap_m;
+    fb["friction"] = s.walls.front_back.friction;
+    walls["front_back"] = fb;
+  } else {
+    walls["front_back"] = nullptr;  // plane strain: no such walls
+  }
   j["walls"] = walls;
   J effects = J::object();
   effects["gravity"] = s.effects.gravity;

@@ -177,6 +177,10 @@ void Simulation::step() {
     lap(phase_s_.contact);
     (this->*g2p_)();
     lap(phase_s_.g2p);
+    if (scene_.walls.front_back.present() && scene_.effects.wall_friction) {
+      front_back_friction();
+      lap(phase_s_.contact);
+    }
     (this->*constitutive_)();
     lap(phase_s_.constitutive);
   });
@@ -604,6 +608,32 @@ void Simulation::contact_walls() {
   wall(scene_.walls.right, 1, nx, nx + P, -P, ny + P, Vec2(-1, 0));
   wall(scene_.walls.bottom, 2, -P, nx + P, -P, 0, Vec2(0, 1));
   wall(scene_.walls.top, 3, -P, nx + P, ny, ny + P, Vec2(0, -1));
+}
+
+// Friction of the front and back walls of a quasi-2D channel (scene walls.front_back): a point
+// pressing on them with sigma_zz < 0 loses up to dt 2 mu |sigma_zz| V / (gap m) of its in-plane
+// speed, against its motion (Coulomb: it may stop, never reverse). Applied to the points' velocities
+// after G2P, so the next P2G carries the loss and the FLIP update does not add it back.
+void Simulation::front_back_friction() {
+  const FrontBackWalls& w = scene_.walls.front_back;
+  const double k = 2.0 * w.friction * dt_s_ / w.gap_m;
+  auto& P = p_;
+  const Vec2 impulse = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<size_t>(0, P.size(), kGrain), Vec2(0.0, 0.0),
+      [&](const tbb::blocked_range<size_t>& r, Vec2 sum) {
+        for (size_t p = r.begin(); p < r.end(); ++p) {
+          const double sigma_zz = P.szz[p] - P.pressure[p];
+          const double speed = std::hypot(P.vx[p], P.vy[p]);
+          if (sigma_zz >= 0.0 || speed == 0.0) continue;
+          const double keep = 1.0 - std::min(speed, k * -sigma_zz * P.volume[p] / P.mass[p]) / speed;
+          sum -= P.mass[p] * (1.0 - keep) * Vec2(P.vx[p], P.vy[p]);
+          P.vx[p] *= keep;
+          P.vy[p] *= keep;
+        }
+        return sum;
+      },
+      [](const Vec2& a, const Vec2& b) { return Vec2(a + b); });
+  stats_.front_back_impulse_N_s_per_m = impulse;
 }
 
 template <class K, bool Flip>

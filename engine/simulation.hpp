@@ -61,6 +61,7 @@ struct StepStats {
   int contact_sweeps = 0;           // Gauss-Seidel sweeps the contact solve took
   double contact_residual_m_s = 0.0;  // largest velocity correction in the last sweep
   bool contact_converged = true;      // the solve met its tolerance within its sweep limit
+  Vec2 front_back_impulse_N_s_per_m{0, 0};  // momentum the front/back walls' friction took this step
 };
 
 // Wall-clock seconds spent in each phase of step(), summed over the run (for profiles: where a
@@ -134,6 +135,7 @@ class Simulation {
   template <class Kernel> void apply_contact_impulse(const ContactPoint& c, const Vec2& J);
   void contact_nodes();
   void contact_walls();
+  void front_back_friction();
   template <class Kernel, bool Flip> void grid_to_particles();
   template <bool Dilatancy, bool Track, bool Rate> void constitutive_update();
   void advance_bodies();
