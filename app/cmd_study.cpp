@@ -166,6 +166,7 @@ int study_main(const Parsed& p) {
     }
 
   bool plotted = false;
+  // writes the tables (and at the end the figure) from an analysed copy of the rungs, returned
   auto write_outputs = [&](bool final_figure) {
     auto copy = rungs;
     const study::Summary s = study::analyse(copy);
@@ -193,13 +194,13 @@ int study_main(const Parsed& p) {
                             {"wall_s", g.ok ? num(g.wall_s) : nlohmann::json(nullptr)},
                             {"estimated_particle_steps", g.estimated_particle_steps}});
     write_file_atomic((out_dir / "study.json").string(), j.dump(2) + "\n");
-    if (!final_figure) return;
-    try {
-      render::write_figure_png(study::study_figure(base.name, q, copy, s), (out_dir / "study.png").string(), true);
-      plotted = true;
-    } catch (const std::exception& e) {
-      std::cerr << "furrow study: warning: no study.png: " << e.what() << "\n";
-    }
+    if (final_figure) try {
+        render::write_figure_png(study::study_figure(base.name, q, copy, s), (out_dir / "study.png").string(), true);
+        plotted = true;
+      } catch (const std::exception& e) {
+        std::cerr << "furrow study: warning: no study.png: " << e.what() << "\n";
+      }
+    return std::make_pair(copy, s);
   };
 
   // ---- rungs, cheapest first, `jobs` at a time, each a child `furrow run` ----
@@ -321,10 +322,7 @@ int study_main(const Parsed& p) {
                  "again to finish the rest.\n", finished, rungs.size(), out_dir.string().c_str());
     return 130;
   }
-  write_outputs(true);
-
-  auto copy = rungs;
-  const study::Summary s = study::analyse(copy);
+  const auto [copy, s] = write_outputs(true);
   size_t no_value = 0;
   for (const auto& g : copy) no_value += g.ok && !std::isfinite(g.value);
   std::printf("study of %zu rungs (%zu reused, %zu failed, %zu without a value): %s/study.md, study.csv%s\n",
