@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "render/inspector.hpp"
 #include "render/inspector_window.hpp"
+#include "render/script.hpp"
 
 namespace fs = std::filesystem;
 
@@ -22,13 +23,8 @@ int inspect_main(const Parsed& p) {
   }
   const bool headless = p.has("--headless");
   if (headless && !p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
-  if (!headless && !render::inspector_window_available()) {
-    std::cerr << "furrow inspect: this furrow was built without GLFW/X11 and has no window; use --headless --script FILE\n";
-    return 2;
-  }
-  const char* display = std::getenv("DISPLAY");
-  if (!headless && !(display && *display)) {
-    std::cerr << "furrow inspect: no display (DISPLAY is not set) for the window; use --headless --script FILE\n";
+  if (!headless && !render::window_unavailable_reason().empty()) {
+    std::cerr << "furrow inspect: " << render::window_unavailable_reason() << "; use --headless --script FILE\n";
     return 2;
   }
   if (p.has("--exit-after-script") && (headless || !p.has("--script")))
@@ -50,18 +46,10 @@ int inspect_main(const Parsed& p) {
     w.script = steps, w.script_path = script, w.exit_after_script = p.has("--exit-after-script");
     return render::run_inspector_window(state, view, w, std::cout, std::cerr);
   }
-  for (const auto& step : steps) {
-    nlohmann::json r;
-    try {
-      r = render::apply_action(state, step.action, &view);
-    } catch (const std::exception& e) {
-      std::cerr << "furrow inspect: " << script << ":" << step.line << ": " << e.what() << "\n";
-      return 1;
-    }
-    r["line"] = step.line;
-    std::cout << r.dump() << "\n" << std::flush;
-  }
-  return 0;
+  return render::replay_script(
+      steps, script, "furrow inspect",
+      [&](const render::ScriptStep& step) { return render::apply_action(state, step.action, &view); }, std::cout,
+      std::cerr);
 }
 
 }  // namespace

@@ -32,4 +32,12 @@ std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option
 void parse_size(const std::string& s, int* w, int* h);
 // The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
 int parse_jobs(const Parsed& p);
+// What a run of the scene will cost and produce, for people: `furrow validate`'s summary, first
+// line 'scene "NAME" (SOURCE) is valid' (app/cmd_scene.cpp).
+std::string scene_summary(const Scene& s, const std::string& source);
+// Writes `text` to `path` through a temporary file in the same directory; an existing file is
+// replaced only with `replace` (and then atomically), otherwise it is never touched and the error
+// reads "PATH: exists; REPLACE_HINT" (app/cmd_scene.cpp).
+void write_text_atomically(const std::string& path, const std::string& text, bool replace,
+                           const std::string& replace_hint);
 }  // namespace furrow::cli
