@@ -13,6 +13,7 @@ Command command_render();     // app/cmd_render.cpp
 Command command_demo();       // app/cmd_render.cpp
 Command command_compare();    // app/cmd_render.cpp
 Command command_inspect();    // app/cmd_inspect.cpp
+Command command_edit();       // app/cmd_edit.cpp
 Command command_sweep();      // app/cmd_sweep.cpp
 Command command_study();      // app/cmd_study.cpp
 Command command_bench();      // app/cmd_bench.cpp
