@@ -24,19 +24,10 @@ std::string edited_path(const std::string& scene) {
 
 int edit_main(const Parsed& p) {
   const std::string scene = p.positional[0];
-  const bool headless = p.has("--headless");
-  if (headless && !p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
-  if (!headless && !render::window_unavailable_reason().empty()) {
-    std::cerr << "furrow edit: " << render::window_unavailable_reason() << "; use --headless --script FILE\n";
-    return 2;
-  }
-  if (p.has("--exit-after-script") && (headless || !p.has("--script")))
-    throw UsageError("--exit-after-script is for a --script replayed in the window (without --headless)");
-  int width = 1280, height = 720;
-  if (p.has("--size")) {
-    parse_size(p.get("--size"), &width, &height);
-    if (width < 400 || height < 300) throw UsageError("--size: the editor needs at least 400x300, got '" + p.get("--size") + "'");
-  }
+  ViewOptions o;
+  if (const int status = view_options(p, "edit", &o)) return status;
+  const bool headless = o.headless;
+  const int width = o.width, height = o.height;
   // the whole script is checked before the scene is even read
   const std::string script = p.get("--script");
   const std::vector<EditStep> steps = script.empty() ? std::vector<EditStep>{} : parse_edit_script(script);

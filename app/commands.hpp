@@ -33,6 +33,14 @@ std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option
 void parse_size(const std::string& s, int* w, int* h);
 // The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
 int parse_jobs(const Parsed& p);
+// The view options of inspect and edit (--headless, --script, --exit-after-script, --size WxH):
+// throws UsageError for a bad combination; returns 2, after saying why on stderr, when a window is
+// wanted but none can open here, else 0 (app/cmd_inspect.cpp).
+struct ViewOptions {
+  bool headless = false;
+  int width = 1280, height = 720;
+};
+int view_options(const Parsed& p, const std::string& command, ViewOptions* o);
 // What a run of the scene will cost and produce, for people: `furrow validate`'s summary, first
 // line 'scene "NAME" (SOURCE) is valid' (app/cmd_scene.cpp).
 std::string scene_summary(const Scene& s, const std::string& source);

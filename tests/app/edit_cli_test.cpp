@@ -33,12 +33,7 @@ class EditCli : public furrow::cli_test::CliFixture {
     std::ofstream(path("script.txt")) << script_text;
     return run({"edit", path("orig.json"), "--headless", "--script", path("script.txt"), "--size", size});
   }
-  static std::vector<json> lines(const std::string& out) {
-    std::vector<json> v;
-    std::istringstream in(out);
-    for (std::string l; std::getline(in, l);) v.push_back(json::parse(l));
-    return v;
-  }
+  static std::vector<json> lines(const std::string& out) { return furrow::cli_test::json_lines(out); }
 };
 
 TEST_F(EditCli, ResizedBodySavedValidatesAndDiffersInThatKeyOnly) {

@@ -56,12 +56,7 @@ class InspectCli : public furrow::cli_test::CliFixture {
     std::ofstream(p) << text;
     return p;
   }
-  static std::vector<json> lines(const std::string& out) {
-    std::vector<json> v;
-    std::istringstream in(out);
-    for (std::string l; std::getline(in, l);) v.push_back(json::parse(l));
-    return v;
-  }
+  static std::vector<json> lines(const std::string& out) { return furrow::cli_test::json_lines(out); }
 };
 
 TEST_F(InspectCli, ScriptedSessionProbesProfilesMeasuresAndScreenshots) {
