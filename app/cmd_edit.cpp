@@ -50,14 +50,14 @@ Command command_edit() {
   return {"edit",
           "edit a scene by script: move and resize bodies, set keys and bed corners, validate, save, screenshot",
           "furrow edit SCENE.json|TEMPLATE [--headless] [--script FILE [--exit-after-script]] [--size WxH]",
-          std::string("Opens SCENE.json (or the template of that name, see 'furrow templates') and replays the\n"
-                      "actions of FILE against it, off-screen. The view draws the domain and its grid, the beds,\n"
+          std::string("Opens SCENE.json (or the template of that name, see 'furrow templates') for editing.\n"
+                      "The view draws the domain and its grid, the beds,\n"
                       "the walls and the bodies at their start positions to scale, beside a panel listing every\n"
                       "scene key with its value and the validation status. On a display the view opens in a\n"
                       "window: drag a body with the left mouse button to move it (a position that would make\n"
                       "the scene invalid is refused and the panel shows why), Ctrl+S saves to SCENE.edited.json\n"
                       "(never over an existing file), Esc quits; a --script is replayed there first. With\n"
-                      "--headless, FILE is replayed off-screen. Each result is one JSON object on\n"
+                      "--headless, the --script FILE is replayed off-screen. Each result is one JSON object on\n"
                       "stdout with \"action\", \"ok\" and the script \"line\". The whole script is checked first:\n"
                       "a bad line is an error naming FILE, the line and what was expected, exit 1, and nothing\n"
                       "runs. The scene is only ever valid: an edit that would make it invalid is refused with\n"

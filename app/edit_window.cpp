@@ -11,6 +11,9 @@ namespace furrow::cli {
 #if defined(FURROW_HAVE_GLFW) && defined(FURROW_HAVE_X11)
 
 namespace {
+// A dragged position to 0.1 mm: the mouse is no more precise, and the saved scene stays readable.
+Vec2 snapped(const Vec2& p_m) { return (p_m * 1e4).array().round().matrix() / 1e4; }
+
 // The index of the topmost body (drawn last) holding the point, or -1.
 int body_under(const Scene& scene, const Vec2& p_m) {
   for (int k = int(scene.bodies.size()) - 1; k >= 0; --k)
@@ -59,7 +62,7 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
     xw.clicked_left = false;
     // every position is validated as the mouse moves: an invalid one is refused (the panel says
     // why) and the body stays at the last valid one
-    if (dragging >= 0 && down) last = apply_edit(s, MoveBody{std::to_string(dragging), p - grab}, &view);
+    if (dragging >= 0 && down) last = apply_edit(s, MoveBody{std::to_string(dragging), snapped(p - grab)}, &view);
     if (dragging >= 0 && !down) {
       if (!last.is_null()) print(last);
       dragging = -1, last = nullptr;

@@ -4,9 +4,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cstdlib>
 #include <map>
 #include <sstream>
+#include <thread>
 
 #include "engine/scene_io.hpp"
 #include "render/image_io.hpp"
@@ -166,3 +168,97 @@ TEST_F(EditCli, WithoutADisplayTheWindowSaysUseHeadless) {
 }
 
 }  // namespace
+
+#if defined(FURROW_HAVE_X11)
+#include <X11/Xlib.h>  // last: X11 macros
+#include <X11/keysym.h>
+#include <dlfcn.h>
+
+namespace {
+
+// XTest from libXtst.so.6, looked up at run time (Debian ships its header only in libxtst-dev).
+struct XTest {
+  void* lib = dlopen("libXtst.so.6", RTLD_NOW);
+  using Motion = int (*)(Display*, int, int, int, unsigned long);
+  using Button = int (*)(Display*, unsigned, int, unsigned long);
+  Motion motion = lib ? reinterpret_cast<Motion>(dlsym(lib, "XTestFakeMotionEvent")) : nullptr;
+  Button button = lib ? reinterpret_cast<Button>(dlsym(lib, "XTestFakeButtonEvent")) : nullptr;
+  Button key = lib ? reinterpret_cast<Button>(dlsym(lib, "XTestFakeKeyEvent")) : nullptr;
+  bool ok() const { return motion && button && key; }
+};
+
+void pause_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
+
+TEST_F(EditCli, WindowDragMovesABodyAndCtrlSSavesBesideTheScene) {
+  const XTest xt;
+  if (!xt.ok()) GTEST_SKIP() << "libXtst.so.6 (XTest) is not installed: no way to drag the mouse";
+  if (std::system("command -v Xvfb >/dev/null 2>&1") != 0) GTEST_SKIP() << "Xvfb is not installed";
+  furrow::cli_test::Xvfb x;
+  if (!x.up) GTEST_SKIP() << "Xvfb could not start on display :" << x.number;
+  const std::string display = ":" + std::to_string(x.number);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    setenv("DISPLAY", display.c_str(), 1);
+    freopen(path("stdout").c_str(), "w", stdout);
+    freopen(path("stderr").c_str(), "w", stderr);
+    execl(FURROW_CLI_PATH, FURROW_CLI_PATH, "edit", path("orig.json").c_str(), (char*)nullptr);
+    _exit(127);
+  }
+  Display* d = XOpenDisplay(display.c_str());
+  ASSERT_NE(d, nullptr);
+  // wait for the editor's window, then drag the plate from its centre 0.2 m to the left
+  int wx = -1, wy = -1;
+  for (int k = 0; k < 100 && wx < 0; ++k, pause_ms(50)) {
+    Window root = DefaultRootWindow(d), r, parent, *kids = nullptr;
+    unsigned n = 0;
+    XQueryTree(d, root, &r, &parent, &kids, &n);
+    for (unsigned c = 0; c < n; ++c) {
+      char* name = nullptr;
+      XWindowAttributes wa;
+      if (XFetchName(d, kids[c], &name) && std::string(name).find("furrow edit") == 0 &&
+          XGetWindowAttributes(d, kids[c], &wa) && wa.map_state == IsViewable) {
+        Window child;
+        XTranslateCoordinates(d, kids[c], root, 0, 0, &wx, &wy, &child);
+      }
+      if (name) XFree(name);
+    }
+    if (kids) XFree(kids);
+  }
+  ASSERT_GE(wx, 0) << "no editor window appeared";
+  pause_ms(300);
+  const furrow::Scene scene = furrow::load_scene(path("orig.json"));
+  const furrow::render::SceneView view(1280, 720);  // the window's default size
+  const Eigen::Vector2d from = view.layout(scene).to_px(scene.bodies[0].start_m);
+  const double px_per_m = view.layout(scene).px_per_m;
+  xt.motion(d, 0, wx + int(from.x()), wy + int(from.y()), 0);
+  XFlush(d), pause_ms(150);
+  xt.button(d, 1, True, 0);
+  XFlush(d), pause_ms(150);
+  for (int s = 1; s <= 10; ++s) {
+    xt.motion(d, 0, wx + int(from.x() - 0.02 * s * px_per_m), wy + int(from.y()), 0);
+    XFlush(d), pause_ms(40);
+  }
+  xt.button(d, 1, False, 0);
+  XFlush(d), pause_ms(300);
+  const unsigned ctrl = XKeysymToKeycode(d, XK_Control_L), s = XKeysymToKeycode(d, XK_s),
+                 esc = XKeysymToKeycode(d, XK_Escape);
+  xt.key(d, ctrl, True, 0), xt.key(d, s, True, 0), xt.key(d, s, False, 0), xt.key(d, ctrl, False, 0);
+  XFlush(d), pause_ms(500);
+  xt.key(d, esc, True, 0), xt.key(d, esc, False, 0);
+  XFlush(d);
+  int status = -1;
+  for (int k = 0; k < 100 && waitpid(pid, &status, WNOHANG) == 0; ++k) pause_ms(50);
+  if (!WIFEXITED(status)) kill(pid, SIGKILL), waitpid(pid, &status, 0);
+  XCloseDisplay(d);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_text(path("stderr"));
+  const auto out = lines(read_text(path("stdout")));
+  ASSERT_EQ(out.size(), 2u) << read_text(path("stdout"));
+  EXPECT_EQ(out[0]["action"], "move");
+  EXPECT_EQ(out[1]["action"], "save");
+  const furrow::Scene moved = furrow::load_scene(path("orig.edited.json"));
+  EXPECT_NEAR(moved.bodies[0].start_m.x(), scene.bodies[0].start_m.x() - 0.2, 2.0 / px_per_m);
+  EXPECT_NEAR(moved.bodies[0].start_m.y(), scene.bodies[0].start_m.y(), 1e-4);
+}
+
+}  // namespace
+#endif
