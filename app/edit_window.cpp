@@ -67,7 +67,10 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
       if (!last.is_null()) print(last);
       dragging = -1, last = nullptr;
     }
-    show();
+    // the panel scrolls with the wheel over it
+    render::ViewInput in;
+    in.mouse_x = float(mx), in.mouse_y = float(my), in.wheel = xw.wheel, xw.wheel = 0;
+    xw.present(view.render(s.scene, editor_panel(s), &in));
   }
   return status;
 }

@@ -71,7 +71,7 @@ struct EditWindowOptions {
 };
 
 // The editor on a display: the same view; drag a body with the left mouse button to move it (an
-// invalid position is refused live and shown in the panel), Ctrl+S saves to `save_path`, Esc
+// invalid position is refused live and shown in the panel), the wheel scrolls the panel, Ctrl+S saves to `save_path`, Esc
 // quits. Each result is one JSON line on `out`. Returns 1 when a script action failed, else 0;
 // throws std::runtime_error when no window can be opened.
 int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOptions& options, std::ostream& out,

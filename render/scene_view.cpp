@@ -105,7 +105,7 @@ SceneView::SceneView(int width, int height)
 
 SceneView::~SceneView() = default;
 
-RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel) {
+RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel, const ViewInput* input) {
   const bool first = !ui_;
   if (first) ui_ = std::make_unique<ImGuiOffscreen>(width_, height_);
   const SceneLayout l = layout(scene);
@@ -115,6 +115,15 @@ RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel) {
   };
   const float clear[3] = {0.16f, 0.17f, 0.2f};
   if (first) ui_->frame(draw, clear);  // the first frame lays the windows out
+  if (input) {
+    ImGuiContext* previous = ImGui::GetCurrentContext();
+    ImGui::SetCurrentContext(ui_->context());
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = ImVec2(input->mouse_x, input->mouse_y);
+    for (int b = 0; b < 3; ++b) io.MouseDown[b] = input->mouse_down[b] && input->mouse_x >= panel_x0();
+    io.MouseWheel = input->wheel;
+    ImGui::SetCurrentContext(previous);
+  }
   return ui_->frame(draw, clear);
 }
 

@@ -12,6 +12,7 @@
 
 #include "engine/scene.hpp"
 #include "render/image_io.hpp"
+#include "render/inspector.hpp"  // ViewInput
 
 namespace furrow::render {
 
@@ -50,7 +51,8 @@ class SceneView {
   SceneView(const SceneView&) = delete;
   SceneView& operator=(const SceneView&) = delete;
 
-  RgbImage render(const Scene& scene, const ScenePanel& panel);
+  // With `input` (a window's mouse), the panel scrolls with the wheel.
+  RgbImage render(const Scene& scene, const ScenePanel& panel, const ViewInput* input = nullptr);
   int width() const { return width_; }
   int height() const { return height_; }
   int panel_x0() const { return width_ - panel_w_; }
