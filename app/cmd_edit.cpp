@@ -48,23 +48,22 @@ int edit_main(const Parsed& p) {
 
 Command command_edit() {
   return {"edit",
-          "edit a scene by script: move and resize bodies, set keys and bed corners, validate, save, screenshot",
+          "edit a scene in a window (drag bodies) or by script: move, resize, set keys and beds, validate, save, screenshot",
           "furrow edit SCENE.json|TEMPLATE [--headless] [--script FILE [--exit-after-script]] [--size WxH]",
           std::string("Opens SCENE.json (or the template of that name, see 'furrow templates') for editing.\n"
-                      "The view draws the domain and its grid, the beds,\n"
-                      "the walls and the bodies at their start positions to scale, beside a panel listing every\n"
-                      "scene key with its value and the validation status. On a display the view opens in a\n"
-                      "window: drag a body with the left mouse button to move it (a position that would make\n"
-                      "the scene invalid is refused and the panel shows why), the wheel scrolls the panel,\n"
-                      "Ctrl+S saves to SCENE.edited.json\n"
-                      "(never over an existing file), Esc quits; a --script is replayed there first. With\n"
-                      "--headless, the --script FILE is replayed off-screen. Each result is one JSON object on\n"
-                      "stdout with \"action\", \"ok\" and the script \"line\". The whole script is checked first:\n"
-                      "a bad line is an error naming FILE, the line and what was expected, exit 1, and nothing\n"
-                      "runs. The scene is only ever valid: an edit that would make it invalid is refused with\n"
-                      "the message of 'furrow validate' (naming the key) and the scene stays as it was. Saves and\n"
-                      "screenshots never replace an existing file (save PATH --overwrite does). Exit status 1\n"
-                      "when any action was refused or failed.\n\n") +
+                      "The view draws the domain and its grid, the beds, the walls and the bodies at their\n"
+                      "start positions to scale, beside a panel listing every scene key with its value and the\n"
+                      "validation status. On a display it opens in a window: drag a body with the left mouse\n"
+                      "button to move it (a position that would make the scene invalid is refused and the panel\n"
+                      "shows why), the wheel scrolls the panel, Ctrl+S saves to SCENE.edited.json (never over an\n"
+                      "existing file), Esc quits; a --script is replayed there first. With --headless, the\n"
+                      "--script FILE is replayed off-screen. Each result is one JSON object on stdout with\n"
+                      "\"action\", \"ok\" and the script \"line\". The whole script is checked first: a bad line is\n"
+                      "an error naming FILE, the line and what was expected, exit 1, and nothing runs. The scene\n"
+                      "is only ever valid: an edit that would make it invalid is refused with the message of\n"
+                      "'furrow validate' (naming the key) and the scene stays as it was. Saves and screenshots\n"
+                      "never replace an existing file (save PATH --overwrite does). Exit status 1 when any\n"
+                      "action was refused or failed.\n\n") +
               kEditScriptHelp,
           {{"--headless", false, false, "no window: replay --script off-screen"},
            {"--script", true, false, "the actions to replay, one per line", "FILE"},
