@@ -7,10 +7,28 @@
 #include "app/commands.hpp"
 #include "render/inspector.hpp"
 #include "render/inspector_window.hpp"
+#include "render/script.hpp"
 
 namespace fs = std::filesystem;
 
 namespace furrow::cli {
+
+int view_options(const Parsed& p, const std::string& command, ViewOptions* o) {
+  o->headless = p.has("--headless");
+  if (o->headless && !p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
+  if (!o->headless && !render::window_unavailable_reason().empty()) {
+    std::cerr << "furrow " << command << ": " << render::window_unavailable_reason() << "; use --headless --script FILE\n";
+    return 2;
+  }
+  if (p.has("--exit-after-script") && (o->headless || !p.has("--script")))
+    throw UsageError("--exit-after-script is for a --script replayed in the window (without --headless)");
+  if (p.has("--size")) {
+    parse_size(p.get("--size"), &o->width, &o->height);
+    if (o->width < 400 || o->height < 300)
+      throw UsageError("--size: the " + command + " view needs at least 400x300, got '" + p.get("--size") + "'");
+  }
+  return 0;
+}
 
 namespace {
 
@@ -20,24 +38,10 @@ int inspect_main(const Parsed& p) {
     std::cerr << "furrow inspect: run directory '" << run_dir << "' does not exist\n";
     return 1;
   }
-  const bool headless = p.has("--headless");
-  if (headless && !p.has("--script")) throw UsageError("--headless needs --script FILE (the actions to replay)");
-  if (!headless && !render::inspector_window_available()) {
-    std::cerr << "furrow inspect: this furrow was built without GLFW/X11 and has no window; use --headless --script FILE\n";
-    return 2;
-  }
-  const char* display = std::getenv("DISPLAY");
-  if (!headless && !(display && *display)) {
-    std::cerr << "furrow inspect: no display (DISPLAY is not set) for the window; use --headless --script FILE\n";
-    return 2;
-  }
-  if (p.has("--exit-after-script") && (headless || !p.has("--script")))
-    throw UsageError("--exit-after-script is for a --script replayed in the window (without --headless)");
-  int width = 1280, height = 720;
-  if (p.has("--size")) {
-    parse_size(p.get("--size"), &width, &height);
-    if (width < 400 || height < 300) throw UsageError("--size: the inspector needs at least 400x300, got '" + p.get("--size") + "'");
-  }
+  ViewOptions o;
+  if (const int status = view_options(p, "inspect", &o)) return status;
+  const bool headless = o.headless;
+  const int width = o.width, height = o.height;
   // the whole script is checked before anything runs
   const std::string script = p.get("--script");
   const std::vector<render::ScriptStep> steps = script.empty() ? std::vector<render::ScriptStep>{}
@@ -50,18 +54,10 @@ int inspect_main(const Parsed& p) {
     w.script = steps, w.script_path = script, w.exit_after_script = p.has("--exit-after-script");
     return render::run_inspector_window(state, view, w, std::cout, std::cerr);
   }
-  for (const auto& step : steps) {
-    nlohmann::json r;
-    try {
-      r = render::apply_action(state, step.action, &view);
-    } catch (const std::exception& e) {
-      std::cerr << "furrow inspect: " << script << ":" << step.line << ": " << e.what() << "\n";
-      return 1;
-    }
-    r["line"] = step.line;
-    std::cout << r.dump() << "\n" << std::flush;
-  }
-  return 0;
+  return render::replay_script(
+      steps, script, "furrow inspect",
+      [&](const render::ScriptStep& step) { return render::apply_action(state, step.action, &view); }, std::cout,
+      std::cerr);
 }
 
 }  // namespace

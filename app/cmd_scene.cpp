@@ -31,8 +31,79 @@ std::string fmt(const char* f, double x) {
 const char* kShapeNames[] = {"circle", "box", "polygon", "union"};
 const char* kShapeFunctionNames[] = {"linear", "quadratic", "cubic"};
 
+// A scene name from an output file name: its stem with anything outside [A-Za-z0-9_.-] as '_'.
+std::string name_from_path(const std::string& path) {
+  std::string stem = fs::path(path).stem().string();
+  for (char& ch : stem)
+    if (!(std::isalnum((unsigned char)ch) || ch == '_' || ch == '-' || ch == '.')) ch = '_';
+  while (!stem.empty() && (stem[0] == '.' || stem[0] == '-')) stem.erase(0, 1);
+  return stem.substr(0, 64);
+}
+
+std::string template_list() {
+  std::string s;
+  for (const auto& t : scene_templates()) s += (s.empty() ? "" : ", ") + t.name;
+  return s;
+}
+
+int validate_main(const Parsed& p) {
+  const std::string& path = p.positional[0];
+  ValidationOptions options;
+  options.allow_large = p.has("--yes");
+  const Scene s = load_scene(path, p.all("--set"), options);
+  if (!p.has("--brief")) std::cout << format_scene(s) << std::flush;
+  std::cerr << scene_summary(s, path);
+  return 0;
+}
+
+int new_main(const Parsed& p) {
+  const std::string& name = p.positional[0];
+  const SceneTemplate* t = find_scene_template(name);
+  if (!t) throw UsageError("unknown template '" + name + "'; available: " + template_list() + " (see 'furrow templates')");
+  if (!p.has("-o")) throw UsageError("missing -o FILE (use -o - for standard output)");
+  const std::string out = p.get("-o");
+  std::vector<std::string> overrides;
+  // the scene is named after its file unless a --set says otherwise
+  bool sets_name = false;
+  for (const auto& o : p.all("--set")) sets_name |= o.rfind("name=", 0) == 0 || o.rfind("/name=", 0) == 0;
+  if (out != "-" && !sets_name && !name_from_path(out).empty()) overrides.push_back("name=\"" + name_from_path(out) + "\"");
+  for (const auto& o : p.all("--set")) overrides.push_back(o);
+  ValidationOptions options;
+  options.allow_large = p.has("--yes");
+  const Scene s = parse_scene_text(t->text, "template " + t->name, overrides, options);
+  const std::string text = format_scene(s);
+  if (out == "-") {
+    std::cout << text << std::flush;
+    return 0;
+  }
+  write_text_atomically(out, text, p.has("--force"), "pass --force to replace it");
+  std::cerr << "wrote " << out << ": scene \"" << s.name << "\" from template " << t->name << ", ~"
+            << estimate_particle_count(s) << " particles, ~" << estimate_step_count(s) << " steps\n";
+  return 0;
+}
+
+int templates_main(const Parsed&) {
+  for (const auto& t : scene_templates()) {
+    std::string n = t.name;
+    if (n.size() < 16) n.resize(16, ' ');
+    std::string d = t.description;
+    for (char& ch : d)
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    std::cout << n << "  " << d << "\n";
+  }
+  return 0;
+}
+
+const char* kSetHelp =
+    "--set key.path=value overrides one value before validation: dots separate object keys and array\n"
+    "indices (an array element may be named by its \"name\"), e.g. --set domain.dx_m=0.005,\n"
+    "--set bodies.plate.friction=0.5, --set 'bodies.0.shape.size_m=[0.05,0.02]'. The value is JSON\n"
+    "when it parses as JSON, otherwise a string. Every key is listed in scenes/README.md.";
+
+}  // namespace
+
 // What a run of this scene will cost and produce, for people (stderr of `furrow validate`).
-std::string summary(const Scene& s, const std::string& source) {
+std::string scene_summary(const Scene& s, const std::string& source) {
   std::ostringstream os;
   const double dx = s.domain.dx_m, dt = estimate_time_step_s(s), t_end = estimate_end_time_s(s);
   const size_t particles = estimate_particle_count(s);
@@ -74,15 +145,14 @@ std::string summary(const Scene& s, const std::string& source) {
   return os.str();
 }
 
-// Writes `text` to `path` through a temporary file in the same directory; an existing file is
-// replaced only with `replace` (and then atomically), otherwise it is never touched.
-void write_atomically(const std::string& path, const std::string& text, bool replace) {
+void write_text_atomically(const std::string& path, const std::string& text, bool replace,
+                           const std::string& replace_hint) {
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");
   if (fs::is_directory(target)) throw std::runtime_error(path + ": is a directory");
   if (!replace && fs::exists(target))
-    throw std::runtime_error(path + ": exists; pass --force to replace it");
+    throw std::runtime_error(path + ": exists; " + replace_hint);
   const fs::path tmp = dir / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()));
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -100,80 +170,9 @@ void write_atomically(const std::string& path, const std::string& text, bool rep
   std::error_code ec;
   if (!replace || rc != 0) fs::remove(tmp, ec);
   if (rc != 0)
-    throw std::runtime_error(path + ": " + (err == EEXIST ? std::string("exists; pass --force to replace it")
+    throw std::runtime_error(path + ": " + (err == EEXIST ? std::string("exists; " + replace_hint)
                                                           : std::string(std::strerror(err))));
 }
-
-// A scene name from an output file name: its stem with anything outside [A-Za-z0-9_.-] as '_'.
-std::string name_from_path(const std::string& path) {
-  std::string stem = fs::path(path).stem().string();
-  for (char& ch : stem)
-    if (!(std::isalnum((unsigned char)ch) || ch == '_' || ch == '-' || ch == '.')) ch = '_';
-  while (!stem.empty() && (stem[0] == '.' || stem[0] == '-')) stem.erase(0, 1);
-  return stem.substr(0, 64);
-}
-
-std::string template_list() {
-  std::string s;
-  for (const auto& t : scene_templates()) s += (s.empty() ? "" : ", ") + t.name;
-  return s;
-}
-
-int validate_main(const Parsed& p) {
-  const std::string& path = p.positional[0];
-  ValidationOptions options;
-  options.allow_large = p.has("--yes");
-  const Scene s = load_scene(path, p.all("--set"), options);
-  if (!p.has("--brief")) std::cout << format_scene(s) << std::flush;
-  std::cerr << summary(s, path);
-  return 0;
-}
-
-int new_main(const Parsed& p) {
-  const std::string& name = p.positional[0];
-  const SceneTemplate* t = find_scene_template(name);
-  if (!t) throw UsageError("unknown template '" + name + "'; available: " + template_list() + " (see 'furrow templates')");
-  if (!p.has("-o")) throw UsageError("missing -o FILE (use -o - for standard output)");
-  const std::string out = p.get("-o");
-  std::vector<std::string> overrides;
-  // the scene is named after its file unless a --set says otherwise
-  bool sets_name = false;
-  for (const auto& o : p.all("--set")) sets_name |= o.rfind("name=", 0) == 0 || o.rfind("/name=", 0) == 0;
-  if (out != "-" && !sets_name && !name_from_path(out).empty()) overrides.push_back("name=\"" + name_from_path(out) + "\"");
-  for (const auto& o : p.all("--set")) overrides.push_back(o);
-  ValidationOptions options;
-  options.allow_large = p.has("--yes");
-  const Scene s = parse_scene_text(t->text, "template " + t->name, overrides, options);
-  const std::string text = format_scene(s);
-  if (out == "-") {
-    std::cout << text << std::flush;
-    return 0;
-  }
-  write_atomically(out, text, p.has("--force"));
-  std::cerr << "wrote " << out << ": scene \"" << s.name << "\" from template " << t->name << ", ~"
-            << estimate_particle_count(s) << " particles, ~" << estimate_step_count(s) << " steps\n";
-  return 0;
-}
-
-int templates_main(const Parsed&) {
-  for (const auto& t : scene_templates()) {
-    std::string n = t.name;
-    if (n.size() < 16) n.resize(16, ' ');
-    std::string d = t.description;
-    for (char& ch : d)
-      if (ch == '\n' || ch == '\r') ch = ' ';
-    std::cout << n << "  " << d << "\n";
-  }
-  return 0;
-}
-
-const char* kSetHelp =
-    "--set key.path=value overrides one value before validation: dots separate object keys and array\n"
-    "indices (an array element may be named by its \"name\"), e.g. --set domain.dx_m=0.005,\n"
-    "--set bodies.plate.friction=0.5, --set 'bodies.0.shape.size_m=[0.05,0.02]'. The value is JSON\n"
-    "when it parses as JSON, otherwise a string. Every key is listed in scenes/README.md.";
-
-}  // namespace
 
 Command command_validate() {
   return {"validate", "check a scene without running it; print it resolved, with its cost",

@@ -13,6 +13,7 @@ Command command_render();     // app/cmd_render.cpp
 Command command_demo();       // app/cmd_render.cpp
 Command command_compare();    // app/cmd_render.cpp
 Command command_inspect();    // app/cmd_inspect.cpp
+Command command_edit();       // app/cmd_edit.cpp
 Command command_sweep();      // app/cmd_sweep.cpp
 Command command_study();      // app/cmd_study.cpp
 Command command_bench();      // app/cmd_bench.cpp
@@ -32,4 +33,20 @@ std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option
 void parse_size(const std::string& s, int* w, int* h);
 // The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
 int parse_jobs(const Parsed& p);
+// The view options of inspect and edit (--headless, --script, --exit-after-script, --size WxH):
+// throws UsageError for a bad combination; returns 2, after saying why on stderr, when a window is
+// wanted but none can open here, else 0 (app/cmd_inspect.cpp).
+struct ViewOptions {
+  bool headless = false;
+  int width = 1280, height = 720;
+};
+int view_options(const Parsed& p, const std::string& command, ViewOptions* o);
+// What a run of the scene will cost and produce, for people: `furrow validate`'s summary, first
+// line 'scene "NAME" (SOURCE) is valid' (app/cmd_scene.cpp).
+std::string scene_summary(const Scene& s, const std::string& source);
+// Writes `text` to `path` through a temporary file in the same directory; an existing file is
+// replaced only with `replace` (and then atomically), otherwise it is never touched and the error
+// reads "PATH: exists; REPLACE_HINT" (app/cmd_scene.cpp).
+void write_text_atomically(const std::string& path, const std::string& text, bool replace,
+                           const std::string& replace_hint);
 }  // namespace furrow::cli

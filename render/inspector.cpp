@@ -13,6 +13,7 @@
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"
 #include "render/imgui_offscreen.hpp"
+#include "render/script.hpp"
 
 namespace fs = std::filesystem;
 
@@ -30,39 +31,10 @@ const char* const kInspectScriptHelp =
     "  length X0 Y0 X1 Y1               the distance (m)\n"
     "  screenshot PATH                  PNG of the view: the frame + the inspector panel\n";
 
-namespace {
-std::vector<std::string> words(const std::string& line) {
-  std::istringstream in(line.substr(0, line.find('#')));
-  std::vector<std::string> w;
-  for (std::string s; in >> s;) w.push_back(s);
-  return w;
-}
-
-bool number(const std::string& s, double* v) {
-  char* end = nullptr;
-  *v = std::strtod(s.c_str(), &end);
-  return !s.empty() && *end == '\0' && std::isfinite(*v);
-}
-
-// Reads `count` numbers from w[1..]; false (with *error) when they are not that.
-bool numbers(const std::vector<std::string>& w, size_t count, size_t optional, std::vector<double>* out,
-             const std::string& expected, std::string* error) {
-  out->clear();
-  const size_t given = w.size() - 1;
-  bool ok = given >= count && given <= count + optional;
-  for (size_t k = 1; ok && k < w.size(); ++k) {
-    double v = 0;
-    ok = number(w[k], &v);
-    out->push_back(v);
-  }
-  if (!ok) *error = "expected '" + expected + "'";
-  return ok;
-}
-}  // namespace
 
 std::optional<InspectAction> parse_inspect_line(const std::string& line, std::string* error) {
   error->clear();
-  const std::vector<std::string> w = words(line);
+  const std::vector<std::string> w = script_words(line);
   if (w.empty()) return std::nullopt;
   const std::string& verb = w[0];
   std::vector<double> v;
@@ -76,20 +48,20 @@ std::optional<InspectAction> parse_inspect_line(const std::string& line, std::st
     return SelectField{w[1]};
   }
   if (verb == "frame") {
-    if (!numbers(w, 1, 0, &v, "frame N", error) || v[0] < 0 || v[0] != std::floor(v[0]))
+    if (!script_numbers(w, 1, 0, &v, "frame N", error) || v[0] < 0 || v[0] != std::floor(v[0]))
       return *error = "expected 'frame N' with N a frame number (0, 1, ...)", std::nullopt;
     return GoToFrame{int64_t(v[0])};
   }
   if (verb == "time") {
-    if (!numbers(w, 1, 0, &v, "time T_S", error)) return std::nullopt;
+    if (!script_numbers(w, 1, 0, &v, "time T_S", error)) return std::nullopt;
     return GoToTime{v[0]};
   }
   if (verb == "probe") {
-    if (!numbers(w, 2, 0, &v, "probe X Y", error)) return std::nullopt;
+    if (!script_numbers(w, 2, 0, &v, "probe X Y", error)) return std::nullopt;
     return Probe{{v[0], v[1]}};
   }
   if (verb == "profile") {
-    if (!numbers(w, 4, 1, &v, "profile X0 Y0 X1 Y1 [N]", error)) return std::nullopt;
+    if (!script_numbers(w, 4, 1, &v, "profile X0 Y0 X1 Y1 [N]", error)) return std::nullopt;
     Profile p{{v[0], v[1]}, {v[2], v[3]}, 50};
     if (v.size() == 5) {
       if (v[4] < 2 || v[4] > 10000 || v[4] != std::floor(v[4]))
@@ -100,14 +72,14 @@ std::optional<InspectAction> parse_inspect_line(const std::string& line, std::st
     return p;
   }
   if (verb == "angle") {
-    if (!numbers(w, 6, 0, &v, "angle AX AY BX BY CX CY", error)) return std::nullopt;
+    if (!script_numbers(w, 6, 0, &v, "angle AX AY BX BY CX CY", error)) return std::nullopt;
     const Angle a{{v[0], v[1]}, {v[2], v[3]}, {v[4], v[5]}};
     if ((a.a_m - a.b_m).norm() == 0 || (a.c_m - a.b_m).norm() == 0)
       return *error = "expected A and C away from the vertex B for 'angle'", std::nullopt;
     return a;
   }
   if (verb == "length") {
-    if (!numbers(w, 4, 0, &v, "length X0 Y0 X1 Y1", error)) return std::nullopt;
+    if (!script_numbers(w, 4, 0, &v, "length X0 Y0 X1 Y1", error)) return std::nullopt;
     return Length{{v[0], v[1]}, {v[2], v[3]}};
   }
   if (verb == "screenshot") {
@@ -119,15 +91,12 @@ std::optional<InspectAction> parse_inspect_line(const std::string& line, std::st
 }
 
 std::vector<ScriptStep> parse_inspect_script(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read the script");
   std::vector<ScriptStep> steps;
-  std::string line, error;
-  for (int n = 1; std::getline(in, line); ++n) {
-    auto a = parse_inspect_line(line, &error);
-    if (!error.empty()) throw std::runtime_error(path + ":" + std::to_string(n) + ": " + error + ", got '" + line + "'");
-    if (a) steps.push_back({n, *a});
-  }
+  parse_script_lines(path, [&](int n, const std::string& line) {
+    std::string error;
+    if (auto a = parse_inspect_line(line, &error)) steps.push_back({n, *a});
+    return error;
+  });
   return steps;
 }
 

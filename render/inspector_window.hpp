@@ -23,6 +23,9 @@ struct WindowOptions {
 
 // Whether this build can open a window at all (GLFW and X11 found at configure time).
 bool inspector_window_available();
+// Why no window can open here ("this furrow was built without GLFW/X11 ...", "no display ..."),
+// or "" when one can; for the inspector and the editor alike.
+std::string window_unavailable_reason();
 
 // Runs until the window closes; returns the exit status (1 when a script line fails, after
 // printing the error naming the script, line and cause to `err`). Throws std::runtime_error when

@@ -17,6 +17,7 @@
 #include "render/image_io.hpp"
 #include "tests/app/cli_fixture.hpp"
 #include "tests/app/stored_run.hpp"
+#include "tests/app/xvfb.hpp"
 
 namespace {
 
@@ -55,12 +56,7 @@ class InspectCli : public furrow::cli_test::CliFixture {
     std::ofstream(p) << text;
     return p;
   }
-  static std::vector<json> lines(const std::string& out) {
-    std::vector<json> v;
-    std::istringstream in(out);
-    for (std::string l; std::getline(in, l);) v.push_back(json::parse(l));
-    return v;
-  }
+  static std::vector<json> lines(const std::string& out) { return furrow::cli_test::json_lines(out); }
 };
 
 TEST_F(InspectCli, ScriptedSessionProbesProfilesMeasuresAndScreenshots) {
@@ -174,38 +170,10 @@ TEST_F(InspectCli, BadScriptLinesNameFileLineAndWhatWasExpected) {
   EXPECT_NE(r.err.find("--headless --script FILE"), std::string::npos) << r.err;
 }
 
-// A virtual X display for the window test: Xvfb on a display number of this process's own.
-struct Xvfb {
-  pid_t pid = -1;
-  int number = 0;
-  bool up = false;
-  Xvfb() {
-    number = 200 + int(::getpid() % 500);
-    pid = fork();
-    if (pid == 0) {
-      const std::string d = ":" + std::to_string(number);
-      freopen("/dev/null", "w", stderr);
-      execlp("Xvfb", "Xvfb", d.c_str(), "-screen", "0", "1600x900x24", "-nolisten", "tcp", (char*)nullptr);
-      _exit(127);
-    }
-    const std::string socket = "/tmp/.X11-unix/X" + std::to_string(number);
-    for (int k = 0; k < 100 && pid > 0 && !up; ++k) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      up = std::filesystem::exists(socket) && waitpid(pid, nullptr, WNOHANG) == 0;
-    }
-  }
-  ~Xvfb() {
-    if (pid > 0) {
-      kill(pid, SIGTERM);
-      waitpid(pid, nullptr, 0);
-    }
-  }
-};
-
 TEST_F(InspectCli, WindowUnderXvfbReplaysAScriptAndScreenshotsTheWindow) {
   if (std::system("command -v Xvfb >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "Xvfb is not installed (apt-get install xvfb, as .ci/setup.sh does): no display to open the window on";
-  Xvfb x;
+  furrow::cli_test::Xvfb x;
   if (!x.up) GTEST_SKIP() << "Xvfb could not start on display :" << x.number;
   const StoredRun stored(dir_ / "run");
   const std::string shot = path("window.png");

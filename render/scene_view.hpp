@@ -1,0 +1,66 @@
+// A scene drawn to scale for `furrow edit`: the domain with its grid, the beds, the walls and the
+// bodies at their start positions on the left, and a Dear ImGui panel on the right listing every
+// scene key with its value and the validation status. Everything is one off-screen ImGui frame
+// (OSMesa), so the headless editor and its tests need no display.
+#pragma once
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/scene.hpp"
+#include "render/image_io.hpp"
+#include "render/inspector.hpp"  // ViewInput
+
+namespace furrow::render {
+
+// What the panel shows besides the scene.
+struct ScenePanel {
+  std::string title;                                      // scene file or template
+  std::vector<std::pair<std::string, std::string>> keys;  // "domain.dx_m", "0.01"
+  std::string status;                                     // "valid" or the refused edit's message
+  bool valid = true;
+  std::vector<std::string> notes;                         // last results
+};
+
+// The bed fill colour (RGB), for the screenshot tests.
+constexpr unsigned char kBedRgb[3] = {196, 164, 108};
+
+// Where the domain sits in the view: pixel (x, y) of a point in metres (y up in the scene,
+// down in the image).
+struct SceneLayout {
+  double origin_x_px = 0, origin_y_px = 0;  // pixel of the domain's (0, 0) corner (bottom-left)
+  double px_per_m = 1;
+  Eigen::Vector2d to_px(const Eigen::Vector2d& p_m) const {
+    return {origin_x_px + p_m.x() * px_per_m, origin_y_px - p_m.y() * px_per_m};
+  }
+  Eigen::Vector2d to_m(const Eigen::Vector2d& px) const {
+    return {(px.x() - origin_x_px) / px_per_m, (origin_y_px - px.y()) / px_per_m};
+  }
+};
+
+// The domain fitted, with a margin, into a canvas of the given size.
+SceneLayout fit_scene(const Domain& d, int canvas_width, int canvas_height);
+
+class SceneView {
+ public:
+  SceneView(int width, int height);
+  ~SceneView();
+  SceneView(const SceneView&) = delete;
+  SceneView& operator=(const SceneView&) = delete;
+
+  // With `input` (a window's mouse), the panel scrolls with the wheel.
+  RgbImage render(const Scene& scene, const ScenePanel& panel, const ViewInput* input = nullptr);
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int panel_x0() const { return width_ - panel_w_; }
+  SceneLayout layout(const Scene& scene) const { return fit_scene(scene.domain, panel_x0(), height_); }
+
+ private:
+  int width_, height_, panel_w_;
+  std::unique_ptr<class ImGuiOffscreen> ui_;
+};
+
+}  // namespace furrow::render
