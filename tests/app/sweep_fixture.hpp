@@ -133,7 +133,13 @@ class SweepCli : public CliFixture {
     for (auto& s : env) e.push_back(s.data());
     a.push_back(nullptr);
     e.push_back(nullptr);
-    const int rc = posix_spawnp(&c.pid, a[0], &fa, nullptr, a.data(), e.data());
+    // its own process group, so a stop can signal the whole job as a batch system does
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attr, 0);
+    const int rc = posix_spawnp(&c.pid, a[0], &fa, &attr, a.data(), e.data());
+    posix_spawnattr_destroy(&attr);
     posix_spawn_file_actions_destroy(&fa);
     if (rc != 0) c.pid = -1;
     return c;

@@ -26,10 +26,12 @@ struct Written {
   bool operator==(const Written& o) const { return dir_inode == o.dir_inode && run_json_inode == o.run_json_inode; }
 };
 
-// The finished runs in a sweep directory (those with a run.json), by name.
+// The finished runs in a sweep directory (those with a run.json), by name. A run being written
+// lives in NAME.partial-PID, which holds its run.json just before the rename: not finished.
 std::map<std::string, Written> finished_runs(const fs::path& sweep_dir) {
   std::map<std::string, Written> out;
   for (const auto& e : fs::directory_iterator(sweep_dir)) {
+    if (e.path().filename().string().find(".partial-") != std::string::npos) continue;
     struct stat d {}, j {};
     if (::stat(e.path().c_str(), &d) == 0 && ::stat((e.path() / "run.json").c_str(), &j) == 0)
       out[e.path().filename().string()] = {d.st_ino, j.st_ino};
@@ -96,7 +98,7 @@ class SweepResume : public SweepCli {
       return {};
     }
     const bool one = wait_until([&] { return fs::exists(out) && !finished_runs(out).empty(); }, 120, &c);
-    ::kill(c.pid, SIGTERM);
+    ::kill(-c.pid, SIGTERM);  // the job's process group (c.pid > 0 checked above)
     const Result r = finish(c);
     EXPECT_TRUE(one) << "no run finished: " << r.err;
     EXPECT_NE(r.status, 0) << "the sweep ended before it was stopped: " << r.err;
@@ -179,7 +181,8 @@ TEST_F(SweepResume, StoppedSweepRunsOnlyTheMissingRunsAgain) {
 
 TEST_F(SweepResume, StoppedMpiJobRunsOnlyTheMissingRunsAgain) {
   if (const std::string why = mpi_unavailable(); !why.empty()) GTEST_SKIP() << why;
-  const std::vector<std::string> vary = {"--vary", "domain.dx_m=0.0035", "--vary", "bodies.rod.start_m.1=0.025:0.04:0.005"};
+  // runs long enough (dx 2.5 mm) that the second pair cannot finish while the stop reaches the ranks
+  const std::vector<std::string> vary = {"--vary", "domain.dx_m=0.0025", "--vary", "bodies.rod.start_m.1=0.025:0.04:0.005"};
   const auto before = stop_after_first_run(mpirun(2, sweep(vary, "sw")), kMpiEnv, path("sw"));
   ASSERT_GE(before.size(), 1u);
   ASSERT_LT(before.size(), 4u);
