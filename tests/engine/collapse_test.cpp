@@ -146,7 +146,7 @@ TEST(CollapseAnalysis, RunJsonHasTheRunoutSeries) {
 // give 1.59); mu(I) shortens it (the friction rises with the shear rate: at I ~ 0.1 by ~0.07, 18% of
 // mu_s). Measured 1.88 and 4.00 (ratio 2.13), 2.07 with the effect off. Against the experiments'
 // 1.2a (Lube et al.) to 1.8a (Lajeunesse et al.) the plane-strain model runs long: 1.64 / 1.88 /
-// 2.01 at dx 8 / 4 / 2 mm, ~2.15 extrapolated: no side walls (README).
+// 2.01 / 1.96 at dx 8 / 4 / 2 / 1 mm: no side walls (README; walls.front_back adds them).
 TEST(ColumnCollapse, RunoutIsLinearInAspectRatioAndMuIShortensIt) {
   const nlohmann::json one = run_collapse(collapse_template({}));
   const nlohmann::json two = run_collapse(collapse_template(kTwice));
