@@ -517,7 +517,8 @@ std::vector<std::pair<double, double>> collapse_surface(const ParticleView& p, c
   return surface;
 }
 
-CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g, double t_s) {
+CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g, double t_s,
+                                std::vector<std::pair<double, double>>* surface) {
   CollapseSample s;
   s.t_s = t_s;
   if (p.count == 0) return s;
@@ -530,7 +531,9 @@ CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g
   std::nth_element(reach.begin(), reach.begin() + std::ptrdiff_t(k), reach.end());
   s.front_m = reach[k] + g.point_half_m;
   s.height_m = 0.0;
-  for (const auto& [x, h] : collapse_surface(p, g)) s.height_m = std::max(s.height_m, h);
+  std::vector<std::pair<double, double>> columns = collapse_surface(p, g);
+  for (const auto& [x, h] : columns) s.height_m = std::max(s.height_m, h);
+  if (surface) *surface = std::move(columns);
   return s;
 }
 
@@ -541,14 +544,15 @@ CollapseAnalysis::CollapseAnalysis(const Scene& scene) : g_(collapse_geometry(sc
 void CollapseAnalysis::add_step(double t_s, const ParticleView& p, bool last) {
   if (!g_.active) return;
   const bool sampled_now = !samples_.empty() && samples_.back().t_s == t_s;
-  if (last ? !sampled_now : t_s >= next_s_ - 1e-12) {
-    samples_.push_back(measure_collapse(p, g_, t_s));
-    next_s_ = t_s + interval_s_;
-  }
+  if (last && sampled_now) samples_.pop_back();  // measured again below, with its surface
+  if (!last && t_s < next_s_ - 1e-12) return;
+  std::vector<std::pair<double, double>> surface;
+  samples_.push_back(measure_collapse(p, g_, t_s, last ? &surface : nullptr));
+  next_s_ = t_s + interval_s_;
   if (!last) return;
   profile_x_m_.clear();
   profile_height_m_.clear();
-  for (const auto& [x, h] : collapse_surface(p, g_)) profile_x_m_.push_back(x), profile_height_m_.push_back(h);
+  for (const auto& [x, h] : surface) profile_x_m_.push_back(x), profile_height_m_.push_back(h);
 }
 
 nlohmann::json CollapseAnalysis::to_json() const {

@@ -177,7 +177,9 @@ std::vector<std::pair<double, double>> collapse_surface(const ParticleView& p, c
 struct CollapseSample {
   double t_s = 0.0, front_m = 0.0, height_m = 0.0;
 };
-CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g, double t_s);
+// `surface`, when given, receives the collapse_surface the height was taken from.
+CollapseSample measure_collapse(const ParticleView& p, const CollapseGeometry& g, double t_s,
+                                std::vector<std::pair<double, double>>* surface = nullptr);
 
 class CollapseAnalysis {
  public:
