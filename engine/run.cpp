@@ -259,7 +259,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   j["peak_resident_bytes"] = peak_resident_bytes();
   const PhaseSeconds& ph = sim.phase_seconds();
   j["phase_seconds"] = {{"sort", ph.sort}, {"p2g", ph.p2g}, {"grid", ph.grid}, {"contact", ph.contact},
-                        {"g2p", ph.g2p}, {"constitutive", ph.constitutive}, {"reorder", ph.reorder}};
+                        {"g2p", ph.g2p}, {"constitutive", ph.constitutive},
+                        {"g2p_constitutive", ph.g2p_constitutive}, {"reorder", ph.reorder}};
   j["state_bytes_per_particle"] = sim.particles().size() ? double(sim.state_bytes()) / sim.particles().size() : 0.0;
   j["frames"] = frame_index;
   j["lead_body_travel_m"] = sim.lead_body_travel_m();

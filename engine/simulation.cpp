@@ -21,6 +21,9 @@ namespace furrow {
 namespace {
 
 constexpr size_t kGrain = 4096;  // particles per TBB task
+// particles G2P and the constitutive update take in turn when fused: their ~20 arrays of a block
+// stay in L2 (256 points x 20 x 8 B = 40 kB)
+constexpr size_t kFusedBlock = 256;
 
 // The P2G strip of `cells` cell columns holding x; strip 0 and the last take the grid margins.
 inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
@@ -67,7 +70,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     p2g_ = flip_ ? &Simulation::particles_to_grid<K, true> : &Simulation::particles_to_grid<K, false>;
     contact_ = scene_.solver.contact == ContactMethod::Particle ? &Simulation::contact_particles<K>
                                                                  : &Simulation::contact_nodes;
-    g2p_ = flip_ ? &Simulation::grid_to_particles<K, true> : &Simulation::grid_to_particles<K, false>;
+    g2p_range_ = flip_ ? &Simulation::g2p_range<K, true> : &Simulation::g2p_range<K, false>;
   };
   switch (scene_.solver.shape_function) {
     case ShapeFunction::Linear: pick(LinearKernel{}); break;
@@ -79,11 +82,11 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   auto pick_law = [&](auto rate) {
     constexpr bool R = decltype(rate)::value;
     if (dilatancy_)
-      constitutive_ = track_plastic_ ? &Simulation::constitutive_update<true, true, R>
-                                     : &Simulation::constitutive_update<true, false, R>;
+      constitutive_range_ = track_plastic_ ? &Simulation::constitutive_range<true, true, R>
+                                           : &Simulation::constitutive_range<true, false, R>;
     else
-      constitutive_ = track_plastic_ ? &Simulation::constitutive_update<false, true, R>
-                                     : &Simulation::constitutive_update<false, false, R>;
+      constitutive_range_ = track_plastic_ ? &Simulation::constitutive_range<false, true, R>
+                                           : &Simulation::constitutive_range<false, false, R>;
   };
   if (scene_.effects.rate_dependence) pick_law(std::true_type{});
   else pick_law(std::false_type{});
@@ -175,14 +178,20 @@ void Simulation::step() {
     lap(phase_s_.grid);
     bodies_and_walls();
     lap(phase_s_.contact);
-    (this->*g2p_)();
-    lap(phase_s_.g2p);
-    if (scene_.walls.front_back.present() && scene_.effects.wall_friction) {
-      front_back_friction();
-      lap(phase_s_.contact);
+    const bool front_back = scene_.walls.front_back.present() && scene_.effects.wall_friction;
+    if (fuse_particle_passes_ && !front_back) {
+      particles_update(true, true);
+      lap(phase_s_.g2p_constitutive);
+    } else {
+      particles_update(true, false);
+      lap(phase_s_.g2p);
+      if (front_back) {
+        front_back_friction();
+        lap(phase_s_.contact);
+      }
+      particles_update(false, true);
+      lap(phase_s_.constitutive);
     }
-    (this->*constitutive_)();
-    lap(phase_s_.constitutive);
   });
   advance_bodies();
   t_s_ += dt_s_;
@@ -637,125 +646,131 @@ void Simulation::front_back_friction() {
 }
 
 template <class K, bool Flip>
-void Simulation::grid_to_particles() {
+void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_, alpha = scene_.solver.flip_blend;
   const double Dinv = K::inv_D(inv_dx);
   const double xmax = scene_.domain.width_m, ymax = scene_.domain.height_m;
   const size_t nb = bodies_.size();
-  struct Local {
-    std::vector<Vec2> impulse;
-    int64_t projected = 0;
-    double vmax2 = 0.0;
-  };
-  tbb::enumerable_thread_specific<Local> locals([&] { return Local{std::vector<Vec2>(nb, Vec2(0, 0))}; });
   auto& P = p_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    Local& loc = locals.local();
-    for (size_t p = r.begin(); p < r.end(); ++p) {
-      double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
-      const double xp = P.x[p], yp = P.y[p];
-      const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
-      const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
-      double vx = 0, vy = 0, b00 = 0, b01 = 0, b10 = 0, b11 = 0, ox = 0, oy = 0;
-      for (int b = 0; b < K::N; ++b) {
-        const size_t row = g_.index(bx, by + b);
-        const double dyp = (by + b) * dx - yp;
-        for (int a = 0; a < K::N; ++a) {
-          const size_t node = row + a;
-          const double w = wx[a] * wy[b];
-          const GridNode& n = g_.node[node];
-          const double gvx = n.vx, gvy = n.vy;
-          vx += w * gvx;
-          vy += w * gvy;
-          if constexpr (Flip) {
-            ox += w * n.vx0;
-            oy += w * n.vy0;
-          }
-          if constexpr (K::mls) {
-            const double dxp = (bx + a) * dx - xp;
-            b00 += w * gvx * dxp;
-            b01 += w * gvx * dyp;
-            b10 += w * gvy * dxp;
-            b11 += w * gvy * dyp;
-          } else {
-            const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
-            b00 += gvx * gxw;
-            b01 += gvx * gyw;
-            b10 += gvy * gxw;
-            b11 += gvy * gyw;
-          }
+  for (size_t p = begin; p < end; ++p) {
+    double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
+    const double xp = P.x[p], yp = P.y[p];
+    const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
+    const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
+    double vx = 0, vy = 0, b00 = 0, b01 = 0, b10 = 0, b11 = 0, ox = 0, oy = 0;
+    for (int b = 0; b < K::N; ++b) {
+      const size_t row = g_.index(bx, by + b);
+      const double dyp = (by + b) * dx - yp;
+      for (int a = 0; a < K::N; ++a) {
+        const size_t node = row + a;
+        const double w = wx[a] * wy[b];
+        const GridNode& n = g_.node[node];
+        const double gvx = n.vx, gvy = n.vy;
+        vx += w * gvx;
+        vy += w * gvy;
+        if constexpr (Flip) {
+          ox += w * n.vx0;
+          oy += w * n.vy0;
+        }
+        if constexpr (K::mls) {
+          const double dxp = (bx + a) * dx - xp;
+          b00 += w * gvx * dxp;
+          b01 += w * gvx * dyp;
+          b10 += w * gvy * dxp;
+          b11 += w * gvy * dyp;
+        } else {
+          const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
+          b00 += gvx * gxw;
+          b01 += gvx * gyw;
+          b10 += gvy * gxw;
+          b11 += gvy * gyw;
         }
       }
-      const double sc = K::mls ? Dinv : 1.0;
-      P.c00[p] = b00 * sc;
-      P.c01[p] = b01 * sc;
-      P.c10[p] = b10 * sc;
-      P.c11[p] = b11 * sc;
-      // positions move with the grid velocity; FLIP keeps part of the particle's own velocity
-      Vec2 x(xp + dt * vx, yp + dt * vy), v(vx, vy);
-      if constexpr (Flip) v += alpha * Vec2(P.vx[p] - ox, P.vy[p] - oy);
-      // safety net: a particle that still ended inside a body is put back on its surface; the
-      // impulse that removes its approach velocity counts in the body's force
-      for (size_t b = 0; b < nb; ++b) {
-        const BodyState& s = bodies_[b];
-        const Vec2 q = x - s.position_m;
-        if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) continue;
-        const Shape& shape = scene_.bodies[b].shape;
-        const double d = shape_sdf(shape, q);
-        if (d >= 0.0) continue;
-        const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
-        x -= d * n;
-        const Vec2 v0 = v;
-        contact(v, s.velocity_m_s, n, 0.0);
-        loc.impulse[b] += P.mass[p] * (v - v0);
-        ++loc.projected;
-      }
-      // the grid margin bounds where a particle may go; walls normally stop it well before
-      if (x.x() < -dx) { x.x() = -dx; v.x() = std::max(v.x(), 0.0); }
-      if (x.x() > xmax + dx) { x.x() = xmax + dx; v.x() = std::min(v.x(), 0.0); }
-      if (x.y() < -dx) { x.y() = -dx; v.y() = std::max(v.y(), 0.0); }
-      if (x.y() > ymax + dx) { x.y() = ymax + dx; v.y() = std::min(v.y(), 0.0); }
-      P.x[p] = x.x();
-      P.y[p] = x.y();
-      P.vx[p] = v.x();
-      P.vy[p] = v.y();
-      loc.vmax2 = std::max(loc.vmax2, v.squaredNorm());
+    }
+    const double sc = K::mls ? Dinv : 1.0;
+    P.c00[p] = b00 * sc;
+    P.c01[p] = b01 * sc;
+    P.c10[p] = b10 * sc;
+    P.c11[p] = b11 * sc;
+    // positions move with the grid velocity; FLIP keeps part of the particle's own velocity
+    Vec2 x(xp + dt * vx, yp + dt * vy), v(vx, vy);
+    if constexpr (Flip) v += alpha * Vec2(P.vx[p] - ox, P.vy[p] - oy);
+    // safety net: a particle that still ended inside a body is put back on its surface; the
+    // impulse that removes its approach velocity counts in the body's force
+    for (size_t b = 0; b < nb; ++b) {
+      const BodyState& s = bodies_[b];
+      const Vec2 q = x - s.position_m;
+      if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) continue;
+      const Shape& shape = scene_.bodies[b].shape;
+      const double d = shape_sdf(shape, q);
+      if (d >= 0.0) continue;
+      const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
+      x -= d * n;
+      const Vec2 v0 = v;
+      contact(v, s.velocity_m_s, n, 0.0);
+      loc.impulse[b] += P.mass[p] * (v - v0);
+      ++loc.projected;
+    }
+    // the grid margin bounds where a particle may go; walls normally stop it well before
+    if (x.x() < -dx) { x.x() = -dx; v.x() = std::max(v.x(), 0.0); }
+    if (x.x() > xmax + dx) { x.x() = xmax + dx; v.x() = std::min(v.x(), 0.0); }
+    if (x.y() < -dx) { x.y() = -dx; v.y() = std::max(v.y(), 0.0); }
+    if (x.y() > ymax + dx) { x.y() = ymax + dx; v.y() = std::min(v.y(), 0.0); }
+    P.x[p] = x.x();
+    P.y[p] = x.y();
+    P.vx[p] = v.x();
+    P.vy[p] = v.y();
+    loc.vmax2 = std::max(loc.vmax2, v.squaredNorm());
+  }
+}
+
+template <bool Dilatancy, bool Track, bool Rate>
+void Simulation::constitutive_range(size_t begin, size_t end) {
+  const double dt = dt_s_;
+  std::vector<PlasticityModel<Dilatancy, Rate>> models;  // once per block of kGrain points: cheap
+  for (const auto& m : materials_) models.push_back({m});
+  auto& P = p_;
+  for (size_t p = begin; p < end; ++p) {
+    PointState s{P.volume[p], P.sxx[p], P.syy[p], P.sxy[p], P.szz[p], P.pressure[p],
+                 Dilatancy ? P.phi_d[p] : 0.0, Track ? P.plastic_strain[p] : 0.0, 0.0};
+    models[P.material[p]].update(dt, P.c00[p], P.c01[p], P.c10[p], P.c11[p], P.mass[p], s);
+    P.volume[p] = s.volume_m2;
+    P.sxx[p] = s.sxx;
+    P.syy[p] = s.syy;
+    P.sxy[p] = s.sxy;
+    P.szz[p] = s.szz;
+    P.pressure[p] = s.pressure_Pa;
+    if constexpr (Dilatancy) P.phi_d[p] = s.phi_d;
+    if constexpr (Track) {
+      P.plastic_strain[p] = s.plastic_strain;
+      P.strain_rate[p] = s.strain_rate_1_s;
+    }
+  }
+}
+
+// G2P and the constitutive update. Fused, each block of particles gets both while it is in cache
+// (one trip through memory per step instead of two; the same arithmetic, so the same bits); apart
+// when the front/back walls' friction must act between them, or for a profile of each phase.
+void Simulation::particles_update(bool g2p, bool constitutive) {
+  const size_t nb = bodies_.size();
+  tbb::enumerable_thread_specific<G2PLocal> locals([&] { return G2PLocal{std::vector<Vec2>(nb, Vec2(0, 0))}; });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, p_.size(), kGrain), [&](const auto& r) {
+    G2PLocal& loc = locals.local();
+    for (size_t b = r.begin(); b < r.end(); b += kFusedBlock) {
+      const size_t e = std::min(r.end(), b + kFusedBlock);
+      if (g2p) (this->*g2p_range_)(b, e, loc);
+      if (constitutive) (this->*constitutive_range_)(b, e);
     }
   });
+  if (!g2p) return;
   stats_.projected_particles = 0;
   double vmax2 = 0.0;
-  for (const Local& loc : locals) {
-    for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m -= loc.impulse[b] / dt;
+  for (const G2PLocal& loc : locals) {
+    for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m -= loc.impulse[b] / dt_s_;
     stats_.projected_particles += loc.projected;
     vmax2 = std::max(vmax2, loc.vmax2);
   }
   stats_.max_speed_m_s = std::sqrt(vmax2);
-}
-
-template <bool Dilatancy, bool Track, bool Rate>
-void Simulation::constitutive_update() {
-  const double dt = dt_s_;
-  std::vector<PlasticityModel<Dilatancy, Rate>> models;
-  for (const auto& m : materials_) models.push_back({m});
-  auto& P = p_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, P.size(), kGrain), [&](const auto& r) {
-    for (size_t p = r.begin(); p < r.end(); ++p) {
-      PointState s{P.volume[p], P.sxx[p], P.syy[p], P.sxy[p], P.szz[p], P.pressure[p],
-                   Dilatancy ? P.phi_d[p] : 0.0, Track ? P.plastic_strain[p] : 0.0, 0.0};
-      models[P.material[p]].update(dt, P.c00[p], P.c01[p], P.c10[p], P.c11[p], P.mass[p], s);
-      P.volume[p] = s.volume_m2;
-      P.sxx[p] = s.sxx;
-      P.syy[p] = s.syy;
-      P.sxy[p] = s.sxy;
-      P.szz[p] = s.szz;
-      P.pressure[p] = s.pressure_Pa;
-      if constexpr (Dilatancy) P.phi_d[p] = s.phi_d;
-      if constexpr (Track) {
-        P.plastic_strain[p] = s.plastic_strain;
-        P.strain_rate[p] = s.strain_rate_1_s;
-      }
-    }
-  });
 }
 
 void Simulation::advance_bodies() {

@@ -68,7 +68,8 @@ struct StepStats {
 // step's time goes; they never feed back into the results).
 struct PhaseSeconds {
   double sort = 0, p2g = 0, grid = 0, contact = 0, g2p = 0, constitutive = 0, reorder = 0;
-  double total() const { return sort + p2g + grid + contact + g2p + constitutive + reorder; }
+  double g2p_constitutive = 0;  // G2P and constitutive update fused into one pass (the default)
+  double total() const { return sort + p2g + grid + contact + g2p + constitutive + g2p_constitutive + reorder; }
 };
 
 // A material point near a body's surface and its contact impulses (particle contact).
@@ -109,6 +110,8 @@ class Simulation {
   double next_dt_s() const;
   const StepStats& stats() const { return stats_; }
   const PhaseSeconds& phase_seconds() const { return phase_s_; }
+  // G2P and the constitutive update as one pass (default) or two (to time each; same results)
+  void set_fused_particle_passes(bool fused) { fuse_particle_passes_ = fused; }
   double wave_speed_m_s() const { return wave_speed_; }
   // distance travelled by the first moving body (m), for end_displacement and averaging windows
   double lead_body_travel_m() const;
@@ -136,8 +139,14 @@ class Simulation {
   void contact_nodes();
   void contact_walls();
   void front_back_friction();
-  template <class Kernel, bool Flip> void grid_to_particles();
-  template <bool Dilatancy, bool Track, bool Rate> void constitutive_update();
+  struct G2PLocal {
+    std::vector<Vec2> impulse;  // per body: the safety net's projections
+    int64_t projected = 0;
+    double vmax2 = 0.0;
+  };
+  template <class Kernel, bool Flip> void g2p_range(size_t begin, size_t end, G2PLocal& loc);
+  template <bool Dilatancy, bool Track, bool Rate> void constitutive_range(size_t begin, size_t end);
+  void particles_update(bool g2p, bool constitutive);
   void advance_bodies();
   void reorder_particles();
 
@@ -161,8 +170,9 @@ class Simulation {
   std::vector<uint32_t> scratch_u32_, chunk_counts_;
   mutable std::vector<double> rho_g_cache_;
   void (Simulation::*p2g_)() = nullptr;
-  void (Simulation::*g2p_)() = nullptr;
-  void (Simulation::*constitutive_)() = nullptr;
+  void (Simulation::*g2p_range_)(size_t, size_t, G2PLocal&) = nullptr;
+  void (Simulation::*constitutive_range_)(size_t, size_t) = nullptr;
+  bool fuse_particle_passes_ = true;
   void (Simulation::*contact_)() = nullptr;
   std::vector<ContactPoint> contacts_;
   std::vector<std::vector<uint32_t>> contact_chunks_;
