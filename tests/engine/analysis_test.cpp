@@ -8,6 +8,7 @@
 #include <random>
 
 #include "engine/analysis.hpp"
+#include "engine/field_store.hpp"
 #include "engine/run.hpp"
 #include "tests/engine/test_scenes.hpp"
 
@@ -319,7 +320,14 @@ TEST(RunAnalysis, RunJsonHasDragStatisticsAndWedgePerFrame) {
   RunOptions opt;
   opt.out_dir = dir;
   opt.write_paraview = false;
+  // a follower sees each frame complete as it is stored, numbered in order
+  int64_t written = 0;
+  opt.frame_written = [&](int64_t index, const std::string& path) {
+    EXPECT_EQ(index, written++);
+    EXPECT_FALSE(read_frame(path).velocity_x.empty()) << path;  // the stored field is there
+  };
   const RunSummary r = run_scene(s, opt);
+  EXPECT_EQ(written, r.run_json.at("frames").get<int64_t>());
   const auto& a = r.run_json.at("analysis");
   EXPECT_EQ(a.at("lead_body"), "plate");
   const auto& d = a.at("drag");
