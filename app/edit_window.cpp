@@ -46,11 +46,25 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
     glfwWaitEventsTimeout(0.5);
     if (!xw.dirty) continue;
     xw.dirty = false;
+    render::ViewInput in;
     for (size_t k = 0; k < xw.keys.size(); ++k) {
-      if (xw.keys[k] == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(xw.glfw, GLFW_TRUE);
-      if (xw.keys[k] == GLFW_KEY_S && (xw.key_mods[k] & GLFW_MOD_CONTROL)) print(apply_edit(s, Save{o.save_path, false}, &view));
+      const int key = xw.keys[k];
+      const bool ctrl = xw.key_mods[k] & GLFW_MOD_CONTROL;
+      // Escape cancels a value being typed, else quits
+      if (key == GLFW_KEY_ESCAPE && view.editing_key().empty()) glfwSetWindowShouldClose(xw.glfw, GLFW_TRUE);
+      if (key == GLFW_KEY_S && ctrl) print(apply_edit(s, Save{o.save_path, false}, &view));
+      const std::pair<int, render::ViewKey> text_keys[] = {
+          {GLFW_KEY_ENTER, render::ViewKey::Enter},       {GLFW_KEY_KP_ENTER, render::ViewKey::Enter},
+          {GLFW_KEY_ESCAPE, render::ViewKey::Escape},     {GLFW_KEY_BACKSPACE, render::ViewKey::Backspace},
+          {GLFW_KEY_DELETE, render::ViewKey::Delete},     {GLFW_KEY_LEFT, render::ViewKey::Left},
+          {GLFW_KEY_RIGHT, render::ViewKey::Right},       {GLFW_KEY_HOME, render::ViewKey::Home},
+          {GLFW_KEY_END, render::ViewKey::End},           {GLFW_KEY_TAB, render::ViewKey::Tab}};
+      for (const auto& [glfw_key, view_key] : text_keys)
+        if (key == glfw_key) in.keys.push_back(view_key);
+      in.ctrl = in.ctrl || ctrl;
     }
-    xw.keys.clear(), xw.key_mods.clear();
+    in.chars = xw.chars;
+    xw.keys.clear(), xw.key_mods.clear(), xw.chars.clear();
     double mx = 0, my = 0;
     glfwGetCursorPos(xw.glfw, &mx, &my);
     const bool down = glfwGetMouseButton(xw.glfw, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
@@ -59,6 +73,7 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
       dragging = body_under(s.scene, p);
       if (dragging >= 0) grab = p - s.scene.bodies[size_t(dragging)].start_m;
     }
+    in.clicked_left = xw.clicked_left && mx >= view.panel_x0();
     xw.clicked_left = false;
     // every position is validated as the mouse moves: an invalid one is refused (the panel says
     // why) and the body stays at the last valid one
@@ -67,10 +82,19 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
       if (!last.is_null()) print(last);
       dragging = -1, last = nullptr;
     }
-    // the panel scrolls with the wheel over it
-    render::ViewInput in;
+    // the panel: wheel scrolling, a clicked key's value typed (checked as typed, set on Enter)
     in.mouse_x = float(mx), in.mouse_y = float(my), in.wheel = xw.wheel, xw.wheel = 0;
-    xw.present(view.render(s.scene, editor_panel(s), &in));
+    in.mouse_down[0] = down;
+    render::PanelChanges changes;
+    const std::string typed_before = s.typing_key + "=" + s.typing_error;
+    xw.present(view.render(s.scene, editor_panel(s), &in, &changes));
+    const nlohmann::json set = panel_edit(s, changes);
+    if (!set.is_null()) {
+      print(set);
+      if (set["ok"] == true) view.stop_editing(), s.typing_key.clear(), s.typing_error.clear();
+    }
+    // the panel shows what was just checked or set
+    if (!set.is_null() || typed_before != s.typing_key + "=" + s.typing_error) xw.dirty = true;
   }
   return status;
 }

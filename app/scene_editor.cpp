@@ -109,20 +109,37 @@ EditorState open_scene_for_edit(const std::string& arg) {
 }
 
 namespace {
-// Applies the overrides to a copy of the document; the copy replaces it only when valid.
+// The overrides applied to a copy of the document and validated: the edited copy and its scene,
+// or the SceneError that refuses them. The one check behind script edits, drags and typed values.
+struct Attempt {
+  nlohmann::json doc;
+  Scene scene;
+  std::optional<SceneError> error;
+};
+Attempt attempt(const EditorState& s, const std::vector<std::string>& assignments) {
+  Attempt a;
+  try {
+    a.doc = s.doc;
+    for (const auto& x : assignments) apply_override(a.doc, x, s.source);
+    a.scene = parse_scene(a.doc, s.source);
+  } catch (const SceneError& e) {
+    a.error = e;
+  }
+  return a;
+}
+
+// Applies the overrides when valid; otherwise the state stays as it was.
 nlohmann::json edit(EditorState& s, const std::string& action, const std::vector<std::string>& assignments) {
   nlohmann::json r = {{"action", action}, {"set", assignments}};
-  try {
-    nlohmann::json doc = s.doc;
-    for (const auto& a : assignments) apply_override(doc, a, s.source);
-    Scene scene = parse_scene(doc, s.source);
-    s.doc = std::move(doc), s.scene = std::move(scene), s.refused.clear();
-    r["ok"] = true;
-    s.notes.push_back(action + ": " + assignments.front() + (assignments.size() > 1 ? " ..." : ""));
-  } catch (const SceneError& e) {
-    r["ok"] = false, r["error"] = e.what(), r["key"] = e.path;
-    s.refused = std::string("refused ") + action + ": " + e.what();
+  Attempt a = attempt(s, assignments);
+  if (a.error) {
+    r["ok"] = false, r["error"] = a.error->what(), r["key"] = a.error->path;
+    s.refused = std::string("refused ") + action + ": " + a.error->what();
+    return r;
   }
+  s.doc = std::move(a.doc), s.scene = std::move(a.scene), s.refused.clear();
+  r["ok"] = true;
+  s.notes.push_back(action + ": " + assignments.front() + (assignments.size() > 1 ? " ..." : ""));
   return r;
 }
 
@@ -199,12 +216,30 @@ void flatten(const nlohmann::json& j, const std::string& prefix, std::vector<std
 }
 }  // namespace
 
+nlohmann::json panel_edit(EditorState& s, const render::PanelChanges& e) {
+  s.typing_key = e.key;
+  if (e.key.empty()) {
+    s.typing_error.clear();
+    return nullptr;
+  }
+  const std::string assignment = e.key + "=" + e.text;
+  if (!e.committed) {
+    const Attempt a = attempt(s, {assignment});
+    s.typing_error = a.error ? a.error->what() : "";
+    return nullptr;
+  }
+  nlohmann::json r = apply_edit(s, SetKey{assignment}, nullptr);
+  s.typing_error = r["ok"] == true ? "" : r["error"].get<std::string>();
+  return r;
+}
+
 render::ScenePanel editor_panel(const EditorState& s) {
   render::ScenePanel p;
   p.title = s.source;
   p.valid = s.refused.empty();
   p.status = p.valid ? "valid (furrow validate)" : s.refused;
   p.notes = s.notes;
+  p.typing_key = s.typing_key, p.typing_error = s.typing_error;
   flatten(scene_to_json(s.scene), "", &p.keys);
   return p;
 }

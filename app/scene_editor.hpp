@@ -45,6 +45,8 @@ struct EditorState {
   Scene scene;                      // parse_scene(doc)
   std::string refused;              // the last refused edit's message, "" after a valid one
   std::vector<std::string> notes;   // last results, for the panel
+  // a value being typed in the panel: its key and what `set` would answer ("" = accepted)
+  std::string typing_key, typing_error;
 };
 
 // A scene file, else a template name. Throws SceneError for an invalid scene, std::runtime_error
@@ -54,6 +56,12 @@ EditorState open_scene_for_edit(const std::string& file_or_template);
 // Applies one action; refused edits and saves give {"ok": false, "error": ...}. A screenshot
 // needs a view.
 nlohmann::json apply_edit(EditorState& s, const EditAction& a, render::SceneView* view);
+
+
+// A value typed in the panel is the script's `set KEY VALUE`: while typing it is only checked
+// (typing_error becomes the message `set` would refuse it with, the scene stays) and null is
+// returned; on Enter it is applied as `set` and its result returned. Nothing open: null.
+nlohmann::json panel_edit(EditorState& s, const render::PanelChanges& e);
 
 // What the panel shows: every leaf key of the resolved scene, the status and the notes.
 render::ScenePanel editor_panel(const EditorState& s);
@@ -71,9 +79,10 @@ struct EditWindowOptions {
 };
 
 // The editor on a display: the same view; drag a body with the left mouse button to move it (an
-// invalid position is refused live and shown in the panel), the wheel scrolls the panel, Ctrl+S saves to `save_path`, Esc
-// quits. Each result is one JSON line on `out`. Returns 1 when a script action failed, else 0;
-// throws std::runtime_error when no window can be opened.
+// invalid position is refused live and shown in the panel), the wheel scrolls the panel, a click
+// on a key opens its value for typing (checked as typed like `set`, Enter sets it, Escape
+// cancels), Ctrl+S saves to `save_path`, Esc quits. Each result is one JSON line on `out`. Returns 1 when a script action failed, else 0; throws
+// std::runtime_error when no window can be opened.
 int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOptions& options, std::ostream& out,
                     std::ostream& err);
 

@@ -104,11 +104,17 @@ nlohmann::json write_screenshot(const InspectorState& s, const std::string& path
                                 const InspectorView& view);
 
 // ---- view ---------------------------------------------------------------------------------------
-// The mouse over the view (pixels from its top-left corner), for a window; none off-screen.
+// Keys a text field needs, whatever the window system calls them.
+enum class ViewKey { Enter, Escape, Backspace, Delete, Left, Right, Home, End, Tab };
+// The mouse and keys over the view (pixels from its top-left corner), for a window; none off-screen.
 struct ViewInput {
   float mouse_x = -1, mouse_y = -1;
   bool mouse_down[3] = {false, false, false};
   float wheel = 0;
+  bool clicked_left = false;        // pressed since the last frame (maybe released already)
+  bool ctrl = false;                // held while `keys` were pressed
+  std::vector<ViewKey> keys;        // pressed since the last frame
+  std::vector<unsigned> chars;      // typed since the last frame (Unicode code points)
 };
 
 // The frame drawn by a FrameRenderer (colorbar, time, outlines; no VTK force plot) on the left and
