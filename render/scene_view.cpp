@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "engine/bodies.hpp"
@@ -89,7 +90,7 @@ std::optional<Eigen::Vector2d> SceneView::key_row_px(const std::string& key) con
   return it->second;
 }
 
-bool SceneView::draw_panel(const ScenePanel& p, float x0, float width, float height) {
+bool SceneView::draw_panel(const ScenePanel& p, float x0, float width, float height, bool* preview) {
   bool committed = false;
   rows_.clear();
   ImGui::SetNextWindowPos(ImVec2(x0, 0));
@@ -101,6 +102,13 @@ bool SceneView::draw_panel(const ScenePanel& p, float x0, float width, float hei
   ImGui::TextWrapped("%s", p.status.c_str());
   ImGui::PopStyleColor();
   for (const auto& n : p.notes) ImGui::TextWrapped("%s", n.c_str());
+  if (p.preview_running) ImGui::BeginDisabled();
+  if (ImGui::Button("Preview run")) *preview = true;
+  if (p.preview_running) ImGui::EndDisabled();
+  if (!p.preview_status.empty()) {
+    ImGui::SameLine();
+    ImGui::TextWrapped("%s", p.preview_status.c_str());
+  }
   ImGui::Separator();
   if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
     for (const auto& [k, v] : p.keys) {
@@ -160,14 +168,15 @@ int imgui_key(ViewKey k) {
 }
 }  // namespace
 
-RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel, const ViewInput* input, PanelChanges* edit) {
+RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel, const ViewInput* input, PanelChanges* edit,
+                           const PreviewFrame* preview) {
   const bool first = !ui_;
   if (first) ui_ = std::make_unique<ImGuiOffscreen>(width_, height_);
   const SceneLayout l = layout(scene);
-  bool committed = false;
+  bool committed = false, preview_clicked = false;
   auto draw = [&] {
     draw_scene(ImGui::GetBackgroundDrawList(), scene, l, float(panel_x0()), float(height_));
-    committed |= draw_panel(panel, float(panel_x0()), float(panel_w_), float(height_));
+    committed |= draw_panel(panel, float(panel_x0()), float(panel_w_), float(height_), &preview_clicked);
   };
   const float clear[3] = {0.16f, 0.17f, 0.2f};
   if (first) ui_->frame(draw, clear);  // the first frame lays the windows out
@@ -206,6 +215,22 @@ RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel, const Vi
     edit->key = editing_key_;
     edit->text = editing_key_.empty() ? "" : buffer_;
     edit->committed = committed && !editing_key_.empty();
+    edit->preview = preview_clicked;
+  }
+  if (preview) {
+    // the preview's field over the canvas; a new renderer when its field or range changed
+    char key[160];
+    std::snprintf(key, sizeof key, "%s %.9g %.9g %d", preview->field.c_str(), preview->range.lo, preview->range.hi,
+                  int(preview->range.log));
+    if (!field_ || field_key_ != key) {
+      FrameStyle style;
+      style.field = preview->field;
+      style.range = preview->range;
+      style.width = panel_x0() / 2 * 2, style.height = height_ / 2 * 2;
+      field_ = std::make_unique<FrameRenderer>(style);
+      field_key_ = key;
+    }
+    img.blit(field_->render(preview->frame), 0, 0);
   }
   return img;
 }

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "engine/scene_io.hpp"
+#include "render/colormap.hpp"
 #include "app/scene_editor.hpp"
 #include "render/image_io.hpp"
 #include "render/scene_view.hpp"
@@ -126,6 +127,61 @@ TEST_F(EditCli, ScreenshotShowsTheBedToScaleAndThePanel) {
   const int panel = (img.width - px0) * img.height;
   EXPECT_GT(panel - most, panel / 50);
   EXPECT_GT(counts.size(), 10u);
+}
+
+// Viridis-coloured pixels (the preview's pressure) left of the panel.
+int field_pixels(const furrow::render::RgbImage& img, int panel_x0) {
+  const auto& cmap = furrow::render::load_colormap("viridis");
+  int n = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < panel_x0; ++x) {
+      double d = 0;
+      cmap.nearest_index(img.at(x, y), &d);
+      n += d < 2.0;
+    }
+  return n;
+}
+
+// `preview DIR`: a short run of the scene as edited (capped: 0.05 s here, ~20k particles at most)
+// into a new run directory by the engine's run code; the view then shows its last stored frame.
+TEST_F(EditCli, PreviewRunsTheEditedSceneIntoANewRunAndTheViewShowsItsField) {
+  const std::string run_dir = path("preview");
+  const auto r = edit("move plate 0.5 0.62\nscreenshot " + path("before.png") + "\npreview " + run_dir +
+                      " 0.05\nscreenshot " + path("after.png") + "\npreview " + run_dir + " 0.05\n");
+  EXPECT_EQ(r.status, 1) << r.err;  // the second preview is refused: its directory exists
+  const auto results = lines(r.out);
+  ASSERT_EQ(results.size(), 5u) << r.out;
+  const json& p = results[2];
+  ASSERT_EQ(p["ok"], true) << p.dump();
+  EXPECT_EQ(p["path"], run_dir);
+  EXPECT_NEAR(p["end_time_s"].get<double>(), 0.05, 1e-3);
+  // a frame every 1/20 of the time, the first at t = 0: all stored, and run.json complete
+  EXPECT_EQ(p["frames"], 21);
+  int vdb = 0;
+  for (const auto& f : fs::directory_iterator(fs::path(run_dir) / "frames")) vdb += f.path().extension() == ".vdb";
+  EXPECT_EQ(vdb, 21);
+  const json run_json = json::parse(read_text(fs::path(run_dir) / "run.json"));
+  for (const char* key : {"scene_hash", "particles", "steps", "wall_seconds", "frames", "bodies", "analysis"})
+    EXPECT_TRUE(run_json.contains(key)) << key;
+  EXPECT_EQ(run_json["frames"], 21);
+  EXPECT_EQ(run_json["steps"], p["steps"]);
+  EXPECT_GT(run_json["steps"].get<int>(), 10);
+  // the previewed scene is the edited one (the moved plate), capped
+  const furrow::Scene ran = furrow::load_scene((fs::path(run_dir) / "scene.json").string());
+  EXPECT_DOUBLE_EQ(ran.bodies[0].start_m.x(), 0.5);
+  EXPECT_DOUBLE_EQ(ran.solver.end_time_s, 0.05);
+  EXPECT_EQ(p["shown"]["frame"], 20);
+  EXPECT_EQ(p["shown"]["field"], "pressure");
+  // the view: the scene drawing before, the stored field (pressure in viridis) after
+  const int x0 = results[1]["panel_x0"];
+  const int before = field_pixels(furrow::render::read_png(path("before.png")), x0);
+  const int after = field_pixels(furrow::render::read_png(path("after.png")), x0);
+  EXPECT_LT(before, 500);
+  EXPECT_GT(after, 20000) << "before " << before;
+  // never into an existing directory
+  EXPECT_EQ(results[4]["ok"], false);
+  EXPECT_NE(results[4]["error"].get<std::string>().find("already exists"), std::string::npos) << results[4];
+  EXPECT_EQ(json::parse(read_text(fs::path(run_dir) / "run.json")), run_json);
 }
 
 TEST_F(EditCli, BadScriptLineNamesFileLineAndExpectation) {

@@ -1,6 +1,6 @@
 // The editor's panel, off-screen and in-process: a value typed into a key's row is checked as it
 // is typed and set on Enter by the same code as the script's `set` (same messages, refused edits
-// keep the scene).
+// keep the scene); the preview button's run shows its stored frames in the view.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -9,6 +9,7 @@
 #include <string>
 
 #include "app/scene_editor.hpp"
+#include "engine/scene_io.hpp"
 
 namespace {
 
@@ -100,6 +101,22 @@ TEST(EditPanel, ATypedValueIsCheckedAsTypedAndSetLikeTheScriptsSet) {
   event(s, view, pressed(ViewKey::Escape));
   EXPECT_EQ(view.editing_key(), "");
   EXPECT_DOUBLE_EQ(s.scene.domain.dx_m, 0.02);
+}
+
+TEST(EditPanel, PreviewCapsTheSceneAndLeavesItValid) {
+  const EditorState s = furrow::cli::open_scene_for_edit("plate_intrusion");
+  json capped;
+  furrow::cli::PreviewCaps caps;
+  caps.seconds = 0.05;
+  caps.max_particles = 8000;
+  const furrow::Scene p = furrow::cli::preview_scene(s.scene, caps, &capped);
+  EXPECT_DOUBLE_EQ(p.solver.end_time_s, 0.05);
+  EXPECT_LE(p.solver.max_steps, caps.max_steps);
+  EXPECT_LE(furrow::estimate_particle_count(p), caps.max_particles);
+  EXPECT_GT(p.domain.dx_m, s.scene.domain.dx_m);
+  EXPECT_EQ(capped["domain.dx_m"], p.domain.dx_m);
+  EXPECT_NEAR(p.outputs.frame_interval_s, 0.05 / caps.frames, 1e-15);
+  EXPECT_NO_THROW(furrow::parse_scene(furrow::scene_to_json(p), "preview"));
 }
 
 }  // namespace
