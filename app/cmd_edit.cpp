@@ -37,6 +37,7 @@ int edit_main(const Parsed& p) {
     EditWindowOptions w;
     w.script = steps, w.script_path = script, w.exit_after_script = p.has("--exit-after-script");
     w.save_path = edited_path(scene);
+    w.scene_arg = scene;
     return run_edit_window(state, view, w, std::cout, std::cerr);
   }
   return render::replay_script(
@@ -48,15 +49,18 @@ int edit_main(const Parsed& p) {
 
 Command command_edit() {
   return {"edit",
-          "edit a scene in a window (drag bodies) or by script: move, resize, set keys and beds, validate, save, screenshot",
+          "edit a scene in a window (drag bodies, type values) or by script: move, resize, set keys and beds, validate, save, screenshot, preview",
           "furrow edit SCENE.json|TEMPLATE [--headless] [--script FILE [--exit-after-script]] [--size WxH]",
           std::string("Opens SCENE.json (or the template of that name, see 'furrow templates') for editing.\n"
                       "The view draws the domain and its grid, the beds, the walls and the bodies at their\n"
                       "start positions to scale, beside a panel listing every scene key with its value and the\n"
                       "validation status. On a display it opens in a window: drag a body with the left mouse\n"
                       "button to move it (a position that would make the scene invalid is refused and the panel\n"
-                      "shows why), the wheel scrolls the panel, Ctrl+S saves to SCENE.edited.json (never over an\n"
-                      "existing file), Esc quits; a --script is replayed there first. With --headless, the\n"
+                      "shows why), the wheel scrolls the panel, a click on a key opens its value for typing\n"
+                      "(checked as typed like 'set', Enter sets it, Escape cancels), \"Preview run\" runs the scene\n"
+                      "briefly in the background into SCENE.preview and shows its frames as they are stored,\n"
+                      "Ctrl+S saves to SCENE.edited.json (never over an existing file), Esc quits; a --script is\n"
+                      "replayed there first. With --headless, the\n"
                       "--script FILE is replayed off-screen. Each result is one JSON object on stdout with\n"
                       "\"action\", \"ok\" and the script \"line\". The whole script is checked first: a bad line is\n"
                       "an error naming FILE, the line and what was expected, exit 1, and nothing runs. The scene\n"

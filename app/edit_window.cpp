@@ -26,13 +26,25 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
                     std::ostream& err) {
   render::XWindow xw;
   render::open_window(xw, view.width(), view.height(), "furrow edit " + s.source);
-  auto show = [&] { xw.present(view.render(s.scene, editor_panel(s))); };
+  auto frame = [&]() -> const render::PreviewFrame* { return s.preview_frame ? &*s.preview_frame : nullptr; };
+  auto show = [&] { xw.present(view.render(s.scene, editor_panel(s), nullptr, nullptr, frame())); };
   auto print = [&](const nlohmann::json& r) { out << r.dump() << "\n" << std::flush; };
   show();
   const int status = render::replay_script(
       o.script, o.script_path, "furrow edit",
       [&](const EditStep& step) {
-        nlohmann::json r = apply_edit(s, step.action, &view);
+        nlohmann::json r;
+        if (auto* p = std::get_if<RunPreview>(&step.action)) {
+          // in the window the preview's frames appear as they are stored
+          r = start_preview(s, *p);
+          while (r.is_null()) {
+            if (follow_preview(s)) show();
+            glfwWaitEventsTimeout(0.05);
+            r = finish_preview(s, false);
+          }
+        } else {
+          r = apply_edit(s, step.action, &view);
+        }
         show();
         return r;
       },
@@ -43,14 +55,32 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
   Vec2 grab(0, 0);         // mouse minus body start, kept over the drag
   nlohmann::json last;     // the drag's latest move, printed on release
   while (!glfwWindowShouldClose(xw.glfw)) {
-    glfwWaitEventsTimeout(0.5);
+    // while a preview runs, look for its new frames a few times a second
+    glfwWaitEventsTimeout(s.preview ? 0.1 : 0.5);
+    if (follow_preview(s)) xw.dirty = true;
+    const nlohmann::json ended = finish_preview(s, false);
+    if (!ended.is_null()) print(ended), xw.dirty = true;
     if (!xw.dirty) continue;
     xw.dirty = false;
+    render::ViewInput in;
     for (size_t k = 0; k < xw.keys.size(); ++k) {
-      if (xw.keys[k] == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(xw.glfw, GLFW_TRUE);
-      if (xw.keys[k] == GLFW_KEY_S && (xw.key_mods[k] & GLFW_MOD_CONTROL)) print(apply_edit(s, Save{o.save_path, false}, &view));
+      const int key = xw.keys[k];
+      const bool ctrl = xw.key_mods[k] & GLFW_MOD_CONTROL;
+      // Escape cancels a value being typed, else quits
+      if (key == GLFW_KEY_ESCAPE && view.editing_key().empty()) glfwSetWindowShouldClose(xw.glfw, GLFW_TRUE);
+      if (key == GLFW_KEY_S && ctrl) print(apply_edit(s, Save{o.save_path, false}, &view));
+      const std::pair<int, render::ViewKey> text_keys[] = {
+          {GLFW_KEY_ENTER, render::ViewKey::Enter},       {GLFW_KEY_KP_ENTER, render::ViewKey::Enter},
+          {GLFW_KEY_ESCAPE, render::ViewKey::Escape},     {GLFW_KEY_BACKSPACE, render::ViewKey::Backspace},
+          {GLFW_KEY_DELETE, render::ViewKey::Delete},     {GLFW_KEY_LEFT, render::ViewKey::Left},
+          {GLFW_KEY_RIGHT, render::ViewKey::Right},       {GLFW_KEY_HOME, render::ViewKey::Home},
+          {GLFW_KEY_END, render::ViewKey::End},           {GLFW_KEY_TAB, render::ViewKey::Tab}};
+      for (const auto& [glfw_key, view_key] : text_keys)
+        if (key == glfw_key) in.keys.push_back(view_key);
+      in.ctrl = in.ctrl || ctrl;
     }
-    xw.keys.clear(), xw.key_mods.clear();
+    in.chars = xw.chars;
+    xw.keys.clear(), xw.key_mods.clear(), xw.chars.clear();
     double mx = 0, my = 0;
     glfwGetCursorPos(xw.glfw, &mx, &my);
     const bool down = glfwGetMouseButton(xw.glfw, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
@@ -59,6 +89,7 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
       dragging = body_under(s.scene, p);
       if (dragging >= 0) grab = p - s.scene.bodies[size_t(dragging)].start_m;
     }
+    in.clicked_left = xw.clicked_left && mx >= view.panel_x0();
     xw.clicked_left = false;
     // every position is validated as the mouse moves: an invalid one is refused (the panel says
     // why) and the body stays at the last valid one
@@ -67,10 +98,24 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
       if (!last.is_null()) print(last);
       dragging = -1, last = nullptr;
     }
-    // the panel scrolls with the wheel over it
-    render::ViewInput in;
+    // the panel: wheel scrolling, a clicked key's value typed (checked as typed, set on Enter),
+    // the preview button
     in.mouse_x = float(mx), in.mouse_y = float(my), in.wheel = xw.wheel, xw.wheel = 0;
-    xw.present(view.render(s.scene, editor_panel(s), &in));
+    in.mouse_down[0] = down;
+    render::PanelChanges changes;
+    const std::string typed_before = s.typing_key + "=" + s.typing_error;
+    xw.present(view.render(s.scene, editor_panel(s), &in, &changes, frame()));
+    const nlohmann::json set = panel_edit(s, changes);
+    if (!set.is_null()) {
+      print(set);
+      if (set["ok"] == true) view.stop_editing(), s.typing_key.clear(), s.typing_error.clear();
+    }
+    if (changes.preview) {
+      const nlohmann::json r = start_preview(s, RunPreview{preview_dir_for(o.scene_arg), 0.2});
+      if (!r.is_null()) print(r);
+    }
+    // the panel shows what was just checked or set, and the preview's first frames
+    if (!set.is_null() || changes.preview || typed_before != s.typing_key + "=" + s.typing_error) xw.dirty = true;
   }
   return status;
 }

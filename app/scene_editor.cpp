@@ -1,6 +1,7 @@
 #include "app/scene_editor.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -8,6 +9,8 @@
 
 #include "app/commands.hpp"
 #include "engine/scene_io.hpp"
+#include "engine/field_store.hpp"
+#include "render/inspector.hpp"
 #include "render/script.hpp"
 
 namespace fs = std::filesystem;
@@ -23,6 +26,9 @@ const char* const kEditScriptHelp =
     "  validate                            the summary of 'furrow validate'\n"
     "  save PATH [--overwrite]             the resolved scene JSON (never over a file without --overwrite)\n"
     "  screenshot PATH                     PNG of the view: the scene drawing + the panel (never overwrites)\n"
+    "  preview DIR [SECONDS]               a short run of the scene as edited into the new run directory DIR\n"
+    "                                      (default 0.2 s simulated; dx coarsened to ~20k particles, at most\n"
+    "                                      4000 steps); the view then shows its last stored frame\n"
     "An edit that makes the scene invalid is refused (\"ok\": false, the validation message) and the\n"
     "scene stays as it was; the script goes on and furrow edit exits 1 at the end.\n";
 
@@ -73,7 +79,19 @@ std::optional<EditAction> parse_edit_line(const std::string& line, std::string* 
     if (w.size() != 2) return *error = "expected 'screenshot PATH' (a path without spaces)", std::nullopt;
     return EditScreenshot{w[1]};
   }
-  *error = "expected one of set, move, resize, bed, validate, save, screenshot";
+  if (verb == "preview") {
+    const std::string expected = "preview DIR [SECONDS]";
+    if (w.size() != 2 && w.size() != 3) return *error = "expected '" + expected + "'", std::nullopt;
+    RunPreview p{w[1], 0.2};
+    if (w.size() == 3) {
+      std::vector<std::string> nums = {w[0], w[2]};
+      if (!render::script_numbers(nums, 1, 0, &v, expected, error)) return std::nullopt;
+      if (!(v[0] > 0 && v[0] <= 10)) return *error = "expected '" + expected + "' with 0 < SECONDS <= 10", std::nullopt;
+      p.seconds = v[0];
+    }
+    return p;
+  }
+  *error = "expected one of set, move, resize, bed, validate, save, screenshot, preview";
   return std::nullopt;
 }
 
@@ -109,20 +127,38 @@ EditorState open_scene_for_edit(const std::string& arg) {
 }
 
 namespace {
-// Applies the overrides to a copy of the document; the copy replaces it only when valid.
+// The overrides applied to a copy of the document and validated: the edited copy and its scene,
+// or the SceneError that refuses them. The one check behind script edits, drags and typed values.
+struct Attempt {
+  nlohmann::json doc;
+  Scene scene;
+  std::optional<SceneError> error;
+};
+Attempt attempt(const EditorState& s, const std::vector<std::string>& assignments) {
+  Attempt a;
+  try {
+    a.doc = s.doc;
+    for (const auto& x : assignments) apply_override(a.doc, x, s.source);
+    a.scene = parse_scene(a.doc, s.source);
+  } catch (const SceneError& e) {
+    a.error = e;
+  }
+  return a;
+}
+
+// Applies the overrides when valid; otherwise the state stays as it was.
 nlohmann::json edit(EditorState& s, const std::string& action, const std::vector<std::string>& assignments) {
   nlohmann::json r = {{"action", action}, {"set", assignments}};
-  try {
-    nlohmann::json doc = s.doc;
-    for (const auto& a : assignments) apply_override(doc, a, s.source);
-    Scene scene = parse_scene(doc, s.source);
-    s.doc = std::move(doc), s.scene = std::move(scene), s.refused.clear();
-    r["ok"] = true;
-    s.notes.push_back(action + ": " + assignments.front() + (assignments.size() > 1 ? " ..." : ""));
-  } catch (const SceneError& e) {
-    r["ok"] = false, r["error"] = e.what(), r["key"] = e.path;
-    s.refused = std::string("refused ") + action + ": " + e.what();
+  Attempt a = attempt(s, assignments);
+  if (a.error) {
+    r["ok"] = false, r["error"] = a.error->what(), r["key"] = a.error->path;
+    s.refused = std::string("refused ") + action + ": " + a.error->what();
+    return r;
   }
+  s.doc = std::move(a.doc), s.scene = std::move(a.scene), s.refused.clear();
+  s.preview_frame.reset();  // the view shows the scene as edited again, not an older preview
+  r["ok"] = true;
+  s.notes.push_back(action + ": " + assignments.front() + (assignments.size() > 1 ? " ..." : ""));
   return r;
 }
 
@@ -134,10 +170,10 @@ const Body* find_body(const Scene& scene, const std::string& name_or_index) {
   return nullptr;
 }
 
-// A refused action; only a refused edit marks the panel's status (a failed save leaves the
-// scene as valid as it was).
+// A refused action; only a refused edit marks the panel's status (a failed save or preview leaves
+// the scene as valid as it was).
 nlohmann::json refused(EditorState& s, const std::string& action, const std::string& message) {
-  if (action != "save" && action != "screenshot") s.refused = "refused " + action + ": " + message;
+  if (action != "save" && action != "screenshot" && action != "preview") s.refused = "refused " + action + ": " + message;
   else s.notes.push_back(action + " failed: " + message);
   return {{"action", action}, {"ok", false}, {"error", message}};
 }
@@ -168,10 +204,14 @@ nlohmann::json apply_edit(EditorState& s, const EditAction& action, render::Scen
     } catch (const std::runtime_error& e) {
       r = refused(s, "save", e.what());
     }
+  } else if (auto* a = std::get_if<RunPreview>(&action)) {
+    r = start_preview(s, *a);
+    if (r.is_null()) r = finish_preview(s, true);
   } else if (auto* a = std::get_if<EditScreenshot>(&action)) {
     if (!view) throw std::logic_error("screenshot needs a SceneView");
     try {
-      render::write_png(view->render(s.scene, editor_panel(s)), a->path, false);
+      const render::PreviewFrame* shown = s.preview_frame ? &*s.preview_frame : nullptr;
+      render::write_png(view->render(s.scene, editor_panel(s), nullptr, nullptr, shown), a->path, false);
       const render::SceneLayout l = view->layout(s.scene);
       r = {{"action", "screenshot"}, {"ok", true}, {"path", a->path}, {"width", view->width()},
            {"height", view->height()}, {"panel_x0", view->panel_x0()},
@@ -199,12 +239,113 @@ void flatten(const nlohmann::json& j, const std::string& prefix, std::vector<std
 }
 }  // namespace
 
+nlohmann::json start_preview(EditorState& s, const RunPreview& a) {
+  if (s.preview && !s.preview->done())
+    return refused(s, "preview", "a preview is running into " + s.preview->out_dir() + "; wait for it to end");
+  finish_preview(s, true);  // a finished one's result is dropped: a new one starts
+  PreviewCaps caps;
+  caps.seconds = a.seconds;
+  nlohmann::json capped;
+  try {
+    s.preview = std::make_shared<PreviewRun>(preview_scene(s.scene, caps, &capped), a.out_dir);
+  } catch (const std::runtime_error& e) {  // SceneError too
+    return refused(s, "preview", e.what());
+  }
+  s.preview_capped = capped;
+  s.preview_shown = -1;
+  s.preview_range.reset();
+  s.preview_frame.reset();
+  s.notes.push_back("preview into " + a.out_dir);
+  return nullptr;
+}
+
+bool follow_preview(EditorState& s) {
+  if (!s.preview) return false;
+  const auto [number, path] = s.preview->latest();
+  if (number < 0 || number == s.preview_shown) return false;
+  FieldFrame f;
+  try {
+    f = read_frame(path);
+  } catch (const std::runtime_error&) {
+    return false;  // renamed into place just now: read from the run directory next time
+  }
+  const std::vector<std::string> stored = render::stored_fields(f);
+  const std::string field =
+      std::find(stored.begin(), stored.end(), "pressure") != stored.end() ? "pressure" : render::default_field(stored);
+  if (field.empty()) return false;
+  if (!s.preview_range || (s.preview_frame && s.preview_frame->field != field)) s.preview_range.emplace(field);
+  s.preview_range->add(f);
+  render::FieldRange range;
+  try {
+    range = s.preview_range->range();
+  } catch (const std::runtime_error&) {
+    return false;  // no material with a value yet
+  }
+  s.preview_frame = render::PreviewFrame{std::move(f), field, range};
+  s.preview_shown = number;
+  return true;
+}
+
+nlohmann::json finish_preview(EditorState& s, bool wait) {
+  if (!s.preview || (!wait && !s.preview->done())) return nullptr;
+  nlohmann::json r = {{"action", "preview"}};
+  r.update(s.preview->finish());
+  follow_preview(s);  // the last frame, from the run directory
+  r["capped"] = s.preview_capped;
+  if (s.preview_frame)
+    r["shown"] = {{"frame", s.preview_shown}, {"field", s.preview_frame->field}, {"time_s", s.preview_frame->frame.time_s}};
+  if (r.value("ok", false))
+    s.notes.push_back("preview: " + std::to_string(r["frames"].get<int64_t>()) + " frames in " + r["path"].get<std::string>());
+  else
+    s.notes.push_back("preview failed: " + r.value("error", std::string()));
+  s.preview.reset();
+  return r;
+}
+
+std::string preview_dir_for(const std::string& scene) {
+  fs::path p(scene);
+  const fs::path base = fs::is_regular_file(p) ? p.parent_path() / (p.stem().string() + ".preview")
+                                               : fs::path(p.filename().string() + ".preview");
+  if (!fs::exists(base)) return base.string();
+  for (int k = 2;; ++k) {
+    const fs::path cand = base.string() + "_" + std::to_string(k);
+    if (!fs::exists(cand)) return cand.string();
+  }
+}
+
+nlohmann::json panel_edit(EditorState& s, const render::PanelChanges& e) {
+  s.typing_key = e.key;
+  if (e.key.empty()) {
+    s.typing_error.clear();
+    return nullptr;
+  }
+  const std::string assignment = e.key + "=" + e.text;
+  if (!e.committed) {
+    const Attempt a = attempt(s, {assignment});
+    s.typing_error = a.error ? a.error->what() : "";
+    return nullptr;
+  }
+  nlohmann::json r = apply_edit(s, SetKey{assignment}, nullptr);
+  s.typing_error = r["ok"] == true ? "" : r["error"].get<std::string>();
+  return r;
+}
+
 render::ScenePanel editor_panel(const EditorState& s) {
   render::ScenePanel p;
   p.title = s.source;
   p.valid = s.refused.empty();
   p.status = p.valid ? "valid (furrow validate)" : s.refused;
   p.notes = s.notes;
+  p.typing_key = s.typing_key, p.typing_error = s.typing_error;
+  p.preview_running = s.preview && !s.preview->done();
+  if (s.preview_frame) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "preview%s: frame %lld, t = %.3f s", p.preview_running ? " running" : "",
+                  (long long)s.preview_shown, s.preview_frame->frame.time_s);
+    p.preview_status = buf;
+  } else if (p.preview_running) {
+    p.preview_status = "preview starting";
+  }
   flatten(scene_to_json(s.scene), "", &p.keys);
   return p;
 }

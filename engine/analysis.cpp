@@ -228,6 +228,7 @@ WedgeMeasure measure_wedge(const FieldFrame& f, const BodyOutline& plate, const 
   if (plate.outline_m.empty()) throw std::invalid_argument("measure_wedge: plate outline is empty");
   WedgeMeasure w;
   w.apex_angle_deg = w.left_flank_deg = w.right_flank_deg = w.apex_depth_m = kNaN;
+  w.left_flank_x_m = w.right_flank_x_m = kNaN;
   w.mask.assign(cells, 0);
   const double dx = f.dx_m;
 
@@ -351,6 +352,7 @@ WedgeMeasure measure_wedge(const FieldFrame& f, const BodyOutline& plate, const 
   w.left_flank_deg = std::atan(sL) * deg;
   w.right_flank_deg = std::atan(-sR) * deg;
   w.apex_angle_deg = w.left_flank_deg + w.right_flank_deg;
+  w.left_flank_x_m = aL, w.right_flank_x_m = aR;
   if (sL - sR > 0.0) w.apex_depth_m = (aR - aL) / (sL - sR);
   return w;
 }
@@ -411,6 +413,13 @@ void RunAnalysis::add_frame(const FieldFrame& frame, double travel_m, const Vec2
     e["cells"] = m.cells;
     const double rows = (m.face_y_m - frame.origin_m.y()) / frame.dx_m;
     e["face_offset_cells"] = rows - std::floor(rows);
+    // the flank lines themselves, so a viewer can draw them (render/inspector's overlay)
+    e["face_y_m"] = m.face_y_m;
+    e["left_flank_deg"] = num(m.left_flank_deg);
+    e["right_flank_deg"] = num(m.right_flank_deg);
+    e["left_flank_x_m"] = num(m.left_flank_x_m);
+    e["right_flank_x_m"] = num(m.right_flank_x_m);
+    e["apex_depth_m"] = num(m.apex_depth_m);
   } else {
     e["apex_angle_deg"] = nullptr;
     e["height_m"] = nullptr;
@@ -467,7 +476,10 @@ nlohmann::json RunAnalysis::to_json() const {
                    "with 90 - atan(mu) deg; frames scatter by several degrees, compare medians); "
                    "height_m = depth of the region below the face; face_offset_cells = height of the "
                    "face above the grid node line below it, in cells (near 0 the grid contact lags and "
-                   "the zone may be lost); early/late medians over the frames with an angle in the first "
+                   "the zone may be lost); flank lines: x = left_flank_x_m + tan(left_flank_deg) (face_y_m - y) "
+                   "and x = right_flank_x_m - tan(right_flank_deg) (face_y_m - y), angles from the vertical, "
+                   "positive when converging; apex_depth_m = where they meet below the face (null when they "
+                   "do not); early/late medians over the frames with an angle in the first "
                    "quarter / second half of the travel; see engine/analysis.hpp"},
                   {"frames", frames_}});
   return j;

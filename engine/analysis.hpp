@@ -132,6 +132,9 @@ struct WedgeMeasure {
   double right_flank_deg = 0.0;  // alpha_R
   double height_m = 0.0;         // deepest region row's lower edge below the plate face
   double apex_depth_m = 0.0;     // where the fitted flanks meet (NaN if parallel/diverging)
+  // x of each fitted flank line at the face (a_L, a_R above; NaN when not measurable): with the
+  // face's y and the flank angles, what draws the lines (the inspector's overlay)
+  double left_flank_x_m = 0.0, right_flank_x_m = 0.0;
   double face_y_m = 0.0, face_x0_m = 0.0, face_x1_m = 0.0;  // the plate's bottom face
   std::vector<uint8_t> mask;     // nx*ny, 1 in the region (for plots and tests)
 };

@@ -172,6 +172,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     if (analysis.wants_frames())
       analysis.add_frame(f, sim.lead_body_travel_m(), sim.bodies()[size_t(analysis.lead_index())].velocity_m_s);
     write_frame_vdb(frame_path(tmp_dir.string(), frame_index), f);
+    if (opt.frame_written) opt.frame_written(frame_index, frame_path(tmp_dir.string(), frame_index));
     if (opt.write_paraview) {
       write_vti(frame_path(tmp_dir.string(), frame_index, "vti"), f);
       pvd.push_back({f.time_s, fs::relative(frame_path(tmp_dir.string(), frame_index, "vti"), tmp_dir).string()});

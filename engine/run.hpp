@@ -27,6 +27,9 @@ struct RunOptions {
   bool write_paraview = true;   // .vti per frame + frames.pvd beside the VDB frames
   double progress_interval_s = 0.5;  // wall seconds between progress callbacks
   std::function<void(const RunProgress&)> progress;
+  // Called from the running thread after frame `index` is stored complete at `path` (inside the
+  // temporary directory until the run is renamed into place): a viewer can follow the run.
+  std::function<void(int64_t index, const std::string& path)> frame_written;
 };
 
 // Per-body force summary over the scene's averaging window.

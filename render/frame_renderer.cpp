@@ -190,6 +190,10 @@ struct FrameRenderer::Pipeline {
   vtkNew<vtkPolyData> outlines;
   vtkNew<vtkPolyDataMapper> outline_mapper;
   vtkNew<vtkActor> outline_actor;
+  vtkNew<vtkPolyData> overlay;
+  vtkNew<vtkPolyDataMapper> overlay_mapper;
+  vtkNew<vtkActor> overlay_actor;
+  vtkNew<vtkTextActor> overlay_label;
   // colorbar: one quad per colormap entry, tick marks, and a label under each tick
   vtkNew<vtkPolyData> bar, tick_marks;
   vtkNew<vtkPolyDataMapper2D> bar_mapper, tick_mapper;
@@ -297,6 +301,27 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
   p.outline_actor->GetProperty()->SetLineWidth(float(std::max(2.0, 3.0 * font_scale)));
   p.outline_actor->GetProperty()->LightingOff();
   p.field_ren->AddActor(p.outline_actor);
+
+  p.overlay_mapper->SetInputData(p.overlay);
+  p.overlay_actor->SetMapper(p.overlay_mapper);
+  p.overlay_actor->GetProperty()->SetLineWidth(float(std::max(2.0, 3.0 * font_scale)));
+  p.overlay_actor->GetProperty()->LightingOff();
+  p.overlay_actor->VisibilityOff();
+  p.field_ren->AddActor(p.overlay_actor);
+  {
+    // dark text on a light box: readable over any colormap, and not the overlay's line colour
+    vtkTextProperty* tp = p.overlay_label->GetTextProperty();
+    tp->SetFontSize(std::max(10, int(std::lround(18 * font_scale))));
+    tp->SetColor(0.05, 0.05, 0.05);
+    tp->SetBackgroundColor(1.0, 1.0, 1.0);
+    tp->SetBackgroundOpacity(0.85);
+    tp->SetFontFamilyToArial();
+    tp->SetJustificationToCentered();
+    tp->SetVerticalJustificationToCentered();
+    p.overlay_label->GetPositionCoordinate()->SetCoordinateSystemToViewport();
+    p.overlay_label->VisibilityOff();
+    p.field_ren->AddActor2D(p.overlay_label);
+  }
 
   const double text_rgb[3] = {0.05, 0.05, 0.05};
   const int title_px = std::max(10, int(std::lround(22 * font_scale)));
@@ -488,7 +513,7 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
 
 FrameRenderer::~FrameRenderer() = default;
 
-RgbImage FrameRenderer::render(const FieldFrame& frame) {
+RgbImage FrameRenderer::render(const FieldFrame& frame, const FrameOverlay* overlay) {
   Pipeline& p = *p_;
   const int W = style_.width, H = style_.height;
   if (frame.nx <= 0 || frame.ny <= 0 || !(frame.dx_m > 0))
@@ -554,6 +579,27 @@ RgbImage FrameRenderer::render(const FieldFrame& frame) {
   p.outlines->SetPoints(pts);
   p.outlines->SetLines(lines);
   p.outlines->Modified();
+
+  // overlay: in front of the outlines
+  vtkNew<vtkPoints> opts;
+  vtkNew<vtkCellArray> olines;
+  if (overlay)
+    for (const auto& seg : overlay->segments_m) {
+      const vtkIdType ab[2] = {opts->InsertNextPoint(seg[0].x(), seg[0].y(), 2 * z),
+                               opts->InsertNextPoint(seg[1].x(), seg[1].y(), 2 * z)};
+      olines->InsertNextCell(2, ab);
+    }
+  p.overlay->SetPoints(opts);
+  p.overlay->SetLines(olines);
+  p.overlay->Modified();
+  p.overlay_actor->SetVisibility(overlay && !overlay->segments_m.empty());
+  if (overlay) p.overlay_actor->GetProperty()->SetColor(overlay->rgb[0], overlay->rgb[1], overlay->rgb[2]);
+  p.overlay_label->SetVisibility(overlay && !overlay->label.empty());
+  if (overlay && !overlay->label.empty()) {
+    const Eigen::Vector2d at = layout_.to_pixel(overlay->label_m);
+    p.overlay_label->SetInput(overlay->label.c_str());
+    p.overlay_label->GetPositionCoordinate()->SetValue(at.x(), H - at.y());
+  }
 
   // text
   if (style_.show_title) {

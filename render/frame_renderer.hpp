@@ -108,6 +108,15 @@ struct FrameLayout {
   }
 };
 
+// Marks drawn over the field in world coordinates (the inspector's wedge): line segments in one
+// colour, and a text label centred on a point. Magenta, like no colormap and unlike the outlines.
+struct FrameOverlay {
+  std::vector<std::array<Eigen::Vector2d, 2>> segments_m;
+  std::string label;                 // UTF-8; "" for none
+  Eigen::Vector2d label_m{0, 0};     // the label's centre
+  std::array<float, 3> rgb{1.0f, 0.0f, 1.0f};
+};
+
 // Keeps its VTK pipeline between frames, so a movie pays set-up once. Not thread-safe.
 class FrameRenderer {
  public:
@@ -118,7 +127,7 @@ class FrameRenderer {
   FrameRenderer(const FrameRenderer&) = delete;
   FrameRenderer& operator=(const FrameRenderer&) = delete;
 
-  RgbImage render(const FieldFrame& frame);
+  RgbImage render(const FieldFrame& frame, const FrameOverlay* overlay = nullptr);
   const FrameLayout& layout() const { return layout_; }
   const FrameStyle& style() const { return style_; }
 

@@ -20,6 +20,8 @@ ImGuiOffscreen::ImGuiOffscreen(int width, int height)
   io.IniFilename = nullptr;  // never write imgui.ini into the user's directory
   io.LogFilename = nullptr;
   io.DisplaySize = ImVec2(float(width), float(height));
+  // key indices are ImGui's own (a view feeds io.KeysDown by ImGuiKey_*: no window system here)
+  for (int k = 0; k < ImGuiKey_COUNT; ++k) io.KeyMap[k] = k;
   ImGui::StyleColorsDark();
   gl_->make_current();
   // GLSL 1.50 is the version of an OpenGL 3.2 core context.

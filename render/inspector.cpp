@@ -29,7 +29,9 @@ const char* const kInspectScriptHelp =
     "  profile X0 Y0 X1 Y1 [N]          the selected field at N points (default 50, 2..10000) along the segment\n"
     "  angle AX AY BX BY CX CY          the angle ABC at B (degrees)\n"
     "  length X0 Y0 X1 Y1               the distance (m)\n"
-    "  screenshot PATH                  PNG of the view: the frame + the inspector panel\n";
+    "  screenshot PATH                  PNG of the view: the frame + the inspector panel\n"
+    "  wedge                            the frame's rigid wedge as run.json's analysis stored it\n"
+    "  wedge on|off                     show or hide the wedge overlay (flank lines, apex angle)\n";
 
 
 std::optional<InspectAction> parse_inspect_line(const std::string& line, std::string* error) {
@@ -86,7 +88,12 @@ std::optional<InspectAction> parse_inspect_line(const std::string& line, std::st
     if (w.size() != 2) return *error = "expected 'screenshot PATH' (a path without spaces)", std::nullopt;
     return Screenshot{w[1]};
   }
-  *error = "expected one of field, frame, time, probe, profile, angle, length, screenshot";
+  if (verb == "wedge") {
+    if (w.size() == 1) return ReportWedge{};
+    if (w.size() == 2 && (w[1] == "on" || w[1] == "off")) return ShowWedge{w[1] == "on"};
+    return *error = "expected 'wedge' or 'wedge on|off'", std::nullopt;
+  }
+  *error = "expected one of field, frame, time, probe, profile, angle, length, screenshot, wedge";
   return std::nullopt;
 }
 
@@ -107,12 +114,6 @@ int64_t number_of(const std::string& frame_path) {
   return std::stoll(stem.substr(stem.find('_') + 1));
 }
 
-std::vector<std::string> stored_fields(const FieldFrame& f) {
-  std::vector<std::string> names;
-  for (const auto& info : field_registry())
-    if (info.vector ? !f.velocity_x.empty() : f.scalars.count(info.name) > 0) names.push_back(info.name);
-  return names;
-}
 
 std::string joined(const std::vector<std::string>& v) {
   std::string s;
@@ -132,6 +133,73 @@ void select_field(InspectorState& s, const std::string& name) {
 }
 }  // namespace
 
+std::vector<std::string> stored_fields(const FieldFrame& f) {
+  std::vector<std::string> names;
+  for (const auto& info : field_registry())
+    if (info.vector ? !f.velocity_x.empty() : f.scalars.count(info.name) > 0) names.push_back(info.name);
+  return names;
+}
+
+std::string default_field(const std::vector<std::string>& stored) {
+  for (const char* pick : {"strain_rate", "pressure", "velocity"})
+    if (std::find(stored.begin(), stored.end(), pick) != stored.end()) return pick;
+  return stored.empty() ? "" : stored.front();
+}
+
+namespace {
+// run.json's analysis.wedge.frames: run_scene appends entry k as it writes frame k, so entry k
+// belongs to frame number k; its time must agree (else the entry is not that frame's and is left out).
+void read_wedge_analysis(InspectorState& s) {
+  const fs::path path = fs::path(s.run_dir) / "run.json";
+  if (!fs::exists(path)) return;
+  std::ifstream in(path);
+  nlohmann::json run;
+  try {
+    run = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(path.string() + ": not valid JSON (" + e.what() + ")");
+  }
+  const nlohmann::json* frames = nullptr;
+  if (run.contains("analysis") && run["analysis"].is_object() && run["analysis"].contains("wedge"))
+    frames = &run["analysis"]["wedge"]["frames"];
+  if (!frames) return;
+  if (!frames->is_array()) throw std::runtime_error(path.string() + ": analysis.wedge.frames is not an array");
+  s.wedge_analysis = true;
+  for (size_t k = 0; k < s.frame_numbers.size(); ++k) {
+    const auto n = size_t(s.frame_numbers[k]);
+    if (n >= frames->size()) continue;
+    const nlohmann::json& e = (*frames)[n];
+    if (e.contains("t_s") && std::abs(e["t_s"].get<double>() - s.times_s[k]) <= 1e-9 * std::max(1.0, s.times_s[k]))
+      s.wedge[s.frame_numbers[k]] = e;
+  }
+}
+}  // namespace
+
+std::optional<FrameOverlay> wedge_overlay(const nlohmann::json& e) {
+  for (const char* key : {"face_y_m", "left_flank_x_m", "right_flank_x_m", "left_flank_deg", "right_flank_deg",
+                          "apex_angle_deg", "height_m"})
+    if (!e.contains(key) || !e[key].is_number()) return std::nullopt;
+  const double y0 = e["face_y_m"], xl = e["left_flank_x_m"], xr = e["right_flank_x_m"], h = e["height_m"];
+  const double tl = std::tan(e["left_flank_deg"].get<double>() * M_PI / 180.0),
+               tr = std::tan(e["right_flank_deg"].get<double>() * M_PI / 180.0);
+  // to the apex when the flanks meet near the region's bottom, else over the region's depth
+  double z = h;
+  if (e.contains("apex_depth_m") && e["apex_depth_m"].is_number()) {
+    const double apex = e["apex_depth_m"];
+    if (apex > 0 && apex <= 1.5 * h) z = apex;
+  }
+  FrameOverlay o;
+  const Eigen::Vector2d left_end(xl + tl * z, y0 - z), right_end(xr - tr * z, y0 - z);
+  o.segments_m.push_back({Eigen::Vector2d(xl, y0), left_end});
+  o.segments_m.push_back({Eigen::Vector2d(xr, y0), right_end});
+  char label[48];
+  std::snprintf(label, sizeof label, "apex %.1f\u00b0", e["apex_angle_deg"].get<double>());
+  o.label = label;
+  // under the lower ends, a fifth of the face's width below
+  o.label_m = Eigen::Vector2d(0.5 * (left_end.x() + right_end.x()), y0 - z - 0.2 * std::abs(xr - xl));
+  return o;
+}
+
 InspectorState open_run(const std::string& run_dir, const std::string& field) {
   InspectorState s;
   s.run_dir = run_dir;
@@ -143,16 +211,9 @@ InspectorState open_run(const std::string& run_dir, const std::string& field) {
   const std::vector<FrameScan> scans = scan_frames(s.frame_paths, s.fields);
   for (size_t k = 0; k < s.fields.size(); ++k) s.ranges[s.fields[k]] = scans[k].range;
   s.times_s = scans.empty() ? std::vector<double>{} : scans.front().times_s;
-  if (!field.empty()) {
-    select_field(s, field);
-  } else {
-    for (const char* pick : {"strain_rate", "pressure", "velocity"})
-      if (std::find(s.fields.begin(), s.fields.end(), pick) != s.fields.end()) {
-        s.field = pick;
-        break;
-      }
-    if (s.field.empty()) s.field = s.fields.front();
-  }
+  if (!field.empty()) select_field(s, field);
+  else s.field = default_field(s.fields);
+  read_wedge_analysis(s);
   const fs::path forces = fs::path(run_dir) / "forces.csv";
   if (fs::exists(forces)) {
     ForcePanel panel = read_force_panel(forces.string());
@@ -258,10 +319,15 @@ std::string short_number(double v) {
 }
 }  // namespace
 
-nlohmann::json write_screenshot(const InspectorState& s, const std::string& path, const RgbImage& img, int panel_x0) {
+nlohmann::json write_screenshot(const InspectorState& s, const std::string& path, const RgbImage& img,
+                                const InspectorView& view) {
   write_png(img, path, false);
+  // where the bed landed (bed_origin_px: the pixel of the frame's origin), so a reader can find
+  // world points in the image
+  const FrameLayout& L = view.frame_layout();
   nlohmann::json r = {{"action", "screenshot"}, {"path", path}, {"width", img.width}, {"height", img.height},
-                      {"panel_x0", panel_x0}, {"field", s.field}};
+                      {"panel_x0", view.panel_x0()}, {"field", s.field}, {"bed_origin_px", {L.bed_x0, L.bed_y1}},
+                      {"px_per_m", L.px_per_m}};
   r.update(where(s));
   return r;
 }
@@ -303,7 +369,21 @@ nlohmann::json apply_action(InspectorState& s, const InspectAction& action, Insp
     s.notes.push_back("length " + short_number(r["m"].get<double>()) + " m");
   } else if (auto* a = std::get_if<Screenshot>(&action)) {
     if (!view) throw std::logic_error("screenshot needs an InspectorView");
-    r = write_screenshot(s, a->path, view->render(s), view->panel_x0());
+    r = write_screenshot(s, a->path, view->render(s), *view);
+  } else if (std::get_if<ReportWedge>(&action) || std::get_if<ShowWedge>(&action)) {
+    if (!s.wedge_analysis)
+      throw std::runtime_error(s.run_dir + "/run.json holds no wedge analysis (analysis.wedge: runs of a plate moving "
+                                           "vertically that store velocity frames have one)");
+    if (auto* a = std::get_if<ShowWedge>(&action)) s.show_wedge = a->on;
+    r = {{"action", "wedge"}, {"overlay", s.show_wedge}};
+    const auto it = s.wedge.find(s.frame_numbers[s.current]);
+    r["stored"] = it != s.wedge.end();
+    r["lines"] = it != s.wedge.end() && wedge_overlay(it->second).has_value();
+    if (std::get_if<ReportWedge>(&action) && it != s.wedge.end()) r.update(it->second);
+    r.update(where(s));
+    const nlohmann::json angle = it != s.wedge.end() ? it->second.value("apex_angle_deg", nlohmann::json()) : nullptr;
+    s.notes.push_back(std::string("wedge") + (s.show_wedge ? "" : " (hidden)") + ": " +
+                      (angle.is_number() ? "apex " + short_number(angle.get<double>()) + " deg" : "none in this frame"));
   }
   if (s.notes.size() > 8) s.notes.erase(s.notes.begin(), s.notes.end() - 8);
   return r;
@@ -357,6 +437,15 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
   if (ImGui::SliderInt("frame", &index, 0, int(s.frame_paths.size()) - 1, "%d") && index != int(s.current))
     changes.push_back(GoToFrame{s.frame_numbers[size_t(index)]});
   ImGui::Text("frame %lld   t = %.4f s", (long long)s.frame_numbers[s.current], s.frame.time_s);
+  if (s.wedge_analysis) {
+    bool on = s.show_wedge;
+    if (ImGui::Checkbox("wedge overlay", &on)) changes.push_back(ShowWedge{on});
+    const auto it = s.wedge.find(s.frame_numbers[s.current]);
+    const nlohmann::json angle = it != s.wedge.end() ? it->second.value("apex_angle_deg", nlohmann::json()) : nullptr;
+    ImGui::SameLine();
+    if (angle.is_number()) ImGui::Text("apex %.1f deg", angle.get<double>());
+    else ImGui::TextUnformatted("no wedge in this frame");
+  }
   ImGui::Separator();
   // force against displacement, the current frame marked
   if (s.forces) {
@@ -412,9 +501,14 @@ RgbImage InspectorView::render(const InspectorState& s, const ViewInput* input, 
     renderer_field_ = s.field;
     drawn_path_.clear();
   }
-  if (drawn_path_ != s.frame_paths[s.current] || drawn_field_ != s.field) {
-    field_image_ = frame_->render(s.frame);
-    drawn_path_ = s.frame_paths[s.current], drawn_field_ = s.field;
+  std::optional<FrameOverlay> overlay;
+  if (s.show_wedge) {
+    const auto it = s.wedge.find(s.frame_numbers[s.current]);
+    if (it != s.wedge.end()) overlay = wedge_overlay(it->second);
+  }
+  if (drawn_path_ != s.frame_paths[s.current] || drawn_field_ != s.field || drawn_overlay_ != overlay.has_value()) {
+    field_image_ = frame_->render(s.frame, overlay ? &*overlay : nullptr);
+    drawn_path_ = s.frame_paths[s.current], drawn_field_ = s.field, drawn_overlay_ = overlay.has_value();
   }
   RgbImage out(width_, height_);
   out.blit(field_image_, 0, 0);

@@ -31,7 +31,10 @@ struct Profile {
 struct Angle { Eigen::Vector2d a_m{0, 0}, b_m{0, 0}, c_m{0, 0}; };  // at b
 struct Length { Eigen::Vector2d a_m{0, 0}, b_m{0, 0}; };
 struct Screenshot { std::string path; };
-using InspectAction = std::variant<SelectField, GoToFrame, GoToTime, Probe, Profile, Angle, Length, Screenshot>;
+struct ReportWedge {};               // the current frame's wedge as run.json stored it
+struct ShowWedge { bool on = true; };  // the wedge overlay on or off
+using InspectAction =
+    std::variant<SelectField, GoToFrame, GoToTime, Probe, Profile, Angle, Length, Screenshot, ReportWedge, ShowWedge>;
 
 // One script line as an action. Returns an error text (what was expected, what was found) instead
 // when the line is not one; blank lines and '#' comments give std::nullopt with an empty error.
@@ -60,7 +63,24 @@ struct InspectorState {
   std::string field;
   FieldFrame frame;                              // the current frame
   std::vector<std::string> notes;                // last results, for the panel
+  // run.json's analysis.wedge.frames entry of each stored frame that has one (frame number ->
+  // entry); wedge_analysis says whether run.json has that analysis at all
+  std::map<int64_t, nlohmann::json> wedge;
+  bool wedge_analysis = false;
+  bool show_wedge = true;  // the overlay, on by default where a frame has one
 };
+
+// The fields a frame holds, in registry order.
+std::vector<std::string> stored_fields(const FieldFrame& f);
+// The first stored of strain_rate, pressure, velocity, else the first stored field: what a view
+// shows before the user picks.
+std::string default_field(const std::vector<std::string>& stored);
+
+// The wedge overlay of one run.json wedge entry: both flank lines from the face down to where they
+// meet (to the region's depth when they meet far below it: the early, trapezoidal zone) and the
+// apex angle as a label under them. std::nullopt when the entry has no lines (no angle in that
+// frame, or a run.json written before the lines were stored).
+std::optional<FrameOverlay> wedge_overlay(const nlohmann::json& entry);
 
 // Reads every frame once (times, ranges) and loads the first. `field` empty: the first stored of
 // strain_rate, pressure, velocity, ... Throws naming the run directory, file or field.
@@ -79,15 +99,22 @@ class InspectorView;
 // where there is no material is null). Throws std::runtime_error for what the run cannot do
 // (a frame or field it has not stored). Screenshot needs a view.
 nlohmann::json apply_action(InspectorState& s, const InspectAction& a, InspectorView* view);
-// Writes a screenshot (never over an existing file) and returns its result line.
-nlohmann::json write_screenshot(const InspectorState& s, const std::string& path, const RgbImage& img, int panel_x0);
+// Writes a screenshot of `view` (never over an existing file) and returns its result line.
+nlohmann::json write_screenshot(const InspectorState& s, const std::string& path, const RgbImage& img,
+                                const InspectorView& view);
 
 // ---- view ---------------------------------------------------------------------------------------
-// The mouse over the view (pixels from its top-left corner), for a window; none off-screen.
+// Keys a text field needs, whatever the window system calls them.
+enum class ViewKey { Enter, Escape, Backspace, Delete, Left, Right, Home, End, Tab };
+// The mouse and keys over the view (pixels from its top-left corner), for a window; none off-screen.
 struct ViewInput {
   float mouse_x = -1, mouse_y = -1;
   bool mouse_down[3] = {false, false, false};
   float wheel = 0;
+  bool clicked_left = false;        // pressed since the last frame (maybe released already)
+  bool ctrl = false;                // held while `keys` were pressed
+  std::vector<ViewKey> keys;        // pressed since the last frame
+  std::vector<unsigned> chars;      // typed since the last frame (Unicode code points)
 };
 
 // The frame drawn by a FrameRenderer (colorbar, time, outlines; no VTK force plot) on the left and
@@ -118,6 +145,7 @@ class InspectorView {
   RgbImage field_image_;
   std::string drawn_field_;
   std::string drawn_path_;
+  bool drawn_overlay_ = false;
 };
 
 // Draws the inspector panel as ImGui calls inside the current frame (window at x0, full height,

@@ -28,7 +28,7 @@ int run_inspector_window(InspectorState& s, InspectorView& view, const WindowOpt
   // a screenshot in a window is what the display shows, read back
   auto screenshot = [&](const std::string& path) {
     xw.present(view.render(s));
-    return write_screenshot(s, path, xw.capture(), view.panel_x0());
+    return write_screenshot(s, path, xw.capture(), view);
   };
 
   xw.present(view.render(s));
@@ -58,6 +58,7 @@ int run_inspector_window(InspectorState& s, InspectorView& view, const WindowOpt
         actions.push_back(GoToFrame{s.frame_numbers[s.current + 1]});
       if (key == GLFW_KEY_LEFT && s.current > 0) actions.push_back(GoToFrame{s.frame_numbers[s.current - 1]});
       if (key == GLFW_KEY_S) actions.push_back(Screenshot{next_free_path("inspect.png")});
+      if (key == GLFW_KEY_W && s.wedge_analysis) actions.push_back(ShowWedge{!s.show_wedge});
     }
     xw.keys.clear(), xw.key_mods.clear();
     ViewInput in;

@@ -3,7 +3,7 @@
 // because Mesa's OSMesa library, linked first for VTK (DESIGN 7), owns the process's gl* symbols.
 // Mouse and keys drive the same actions as a script:
 //   panel: field and frame pickers;  click on the field: probe there;
-//   Left/Right: previous/next frame;  S: screenshot (inspect.png, inspect_2.png, ... in the current
+//   Left/Right: previous/next frame;  W: wedge overlay on/off;  S: screenshot (inspect.png, inspect_2.png, ... in the current
 //   folder);  Esc or Q: quit.
 // Each result is printed as one JSON line, as in headless mode.
 #pragma once

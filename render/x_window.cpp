@@ -104,6 +104,10 @@ void open_window(XWindow& xw, int width, int height, const std::string& title) {
     if (action == GLFW_PRESS || action == GLFW_REPEAT)
       self(w)->keys.push_back(key), self(w)->key_mods.push_back(mods), self(w)->dirty = true;
   });
+  glfwSetCharCallback(xw.glfw, [](GLFWwindow* w, unsigned c) {
+    self(w)->chars.push_back(c);
+    self(w)->dirty = true;
+  });
   glfwSetWindowRefreshCallback(xw.glfw, [](GLFWwindow* w) { self(w)->dirty = true; });
   // pixels put before the window is on screen are lost: wait (up to 2 s) until it is viewable
   for (int k = 0; k < 200; ++k) {

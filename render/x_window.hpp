@@ -27,6 +27,7 @@ struct XWindow {
   float wheel = 0;
   std::vector<int> keys;
   std::vector<int> key_mods;  // GLFW_MOD_* of each key in `keys`
+  std::vector<unsigned> chars;  // text typed (Unicode code points)
   bool clicked_left = false;
 
   XWindow() = default;

@@ -8,7 +8,11 @@
 #include <signal.h>
 #include <sys/wait.h>
 
+#include <Eigen/Core>
+
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <sstream>
 #include <thread>
 
@@ -140,6 +144,107 @@ TEST_F(InspectCli, ScriptedSessionProbesProfilesMeasuresAndScreenshots) {
   const auto again = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("screenshot " + shot + "\n")});
   EXPECT_EQ(again.status, 1);
   EXPECT_NE(again.err.find("script.txt:1:"), std::string::npos) << again.err;
+}
+
+// A small stored run of a plate descending into loose DPM material (paper case 4 at dx 4 mm, 10
+// cells across the plate, 29 mm of travel: ~5 s of CPU): the frames where run.json's analysis
+// found flank lines show them in the overlay colour exactly there, and `wedge` prints what run.json
+// stored. The lines are checked against run.json's numbers, not against the overlay's own code.
+TEST_F(InspectCli, WedgeOverlayDrawsTheFlankLinesRunJsonStored) {
+  auto r = run({"new", "loose_intrusion", "-o", path("loose.json"), "--set", "domain.width_m=0.2", "--set",
+                "domain.height_m=0.13", "--set", "domain.dx_m=0.004", "--set", "beds.0.max_m=[0.2,0.1]", "--set",
+                "bodies.plate.start_m=[0.1,0.112]", "--set", "solver.end_displacement_m=0.029", "--set",
+                "outputs.frame_interval_s=0.01", "--set", "outputs.fields=[\"velocity\",\"strain_rate\"]", "--set",
+                "outputs.movies=[]"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run({"run", path("loose.json"), "--out", path("run"), "--no-movies"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json frames = json::parse(furrow::cli_test::read_text(dir_ / "run" / "run.json"))["analysis"]["wedge"]["frames"];
+  // the last frame with flank lines, and one without an angle
+  int with = -1, without = -1;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    if (frames[k]["left_flank_x_m"].is_number()) with = int(k);
+    else if (without < 0) without = int(k);
+  }
+  ASSERT_GE(with, 0) << "no frame of the run has a wedge with flanks";
+  ASSERT_GE(without, 0);
+  const json& e = frames[size_t(with)];
+  const std::string on = path("on.png"), off = path("off.png"), none = path("none.png");
+  r = run({"inspect", path("run"), "--headless", "--script",
+           script("frame " + std::to_string(with) + "\nwedge\nscreenshot " + on + "\nwedge off\nscreenshot " + off +
+                  "\nwedge on\nframe " + std::to_string(without) + "\nwedge\nscreenshot " + none + "\n")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<json> out = lines(r.out);
+  ASSERT_EQ(out.size(), 9u) << r.out;
+  // `wedge`: run.json's entry for that frame, to the bit
+  const json& w = out[1];
+  EXPECT_EQ(w["action"], "wedge");
+  EXPECT_EQ(w["frame"], with);
+  EXPECT_EQ(w["overlay"], true);
+  EXPECT_EQ(w["lines"], true);
+  for (const char* key : {"apex_angle_deg", "left_flank_deg", "right_flank_deg", "left_flank_x_m", "right_flank_x_m",
+                          "face_y_m", "height_m"})
+    EXPECT_EQ(w[key].get<double>(), e[key].get<double>()) << key;
+  EXPECT_EQ(out[7]["apex_angle_deg"], nullptr);
+  EXPECT_EQ(out[7]["lines"], false);
+
+  // the stored lines in pixels: x = x_face +- tan(angle) (face_y - y), down to the region's depth
+  // (or the apex, above it)
+  const json& shot = out[2];
+  const double ox = shot["bed_origin_px"][0], oy = shot["bed_origin_px"][1], ppm = shot["px_per_m"];
+  const double y0 = e["face_y_m"], deg = M_PI / 180;
+  const double depth = e["apex_depth_m"].is_number() ? std::min(e["height_m"].get<double>(), e["apex_depth_m"].get<double>())
+                                                     : e["height_m"].get<double>();
+  struct Line { double x0, slope; };  // x(z) = x0 + slope z, z = face_y - y
+  const Line lines_m[2] = {{e["left_flank_x_m"], std::tan(e["left_flank_deg"].get<double>() * deg)},
+                           {e["right_flank_x_m"], -std::tan(e["right_flank_deg"].get<double>() * deg)}};
+  auto px = [&](double x, double y) { return std::pair<double, double>(ox + x * ppm, oy - y * ppm); };
+  auto magenta = [](const uint8_t* p) { return p[0] > 220 && p[1] < 40 && p[2] > 220; };
+  const auto img = furrow::render::read_png(on);
+  // along each stored line, overlay pixels within 2 px
+  for (const Line& l : lines_m)
+    for (int n = 1; n < 10; ++n) {
+      const double z = depth * n / 10.0;
+      const auto [cx, cy] = px(l.x0 + l.slope * z, y0 - z);
+      bool hit = false;
+      for (int dy = -2; dy <= 2 && !hit; ++dy)
+        for (int dx = -2; dx <= 2 && !hit; ++dx) hit = magenta(img.at(int(std::lround(cx)) + dx, int(std::lround(cy)) + dy));
+      EXPECT_TRUE(hit) << "no overlay pixel near (" << cx << ", " << cy << ") on the line from x " << l.x0;
+    }
+  // and every overlay pixel lies on a stored line (within 2.5 px: the lines are ~3 px wide)
+  int overlay_px = 0, off_line = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < shot["panel_x0"].get<int>(); ++x) {
+      if (!magenta(img.at(x, y))) continue;
+      ++overlay_px;
+      // distance to the segment of each line from the face to 1.5 region depths below it (the
+      // overlay stops at the region's depth or the apex: only where along the line is not checked)
+      const Eigen::Vector2d q(x + 0.5, y + 0.5);
+      double best = 1e9;
+      for (const Line& l : lines_m) {
+        const auto [ax, ay] = px(l.x0, y0);
+        const auto [bx, by] = px(l.x0 + l.slope * 1.5 * e["height_m"].get<double>(), y0 - 1.5 * e["height_m"].get<double>());
+        const Eigen::Vector2d a(ax, ay), b(bx, by);
+        const double t = std::clamp((q - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+        best = std::min(best, (q - (a + t * (b - a))).norm());
+      }
+      off_line += best > 2.5;
+    }
+  EXPECT_GT(overlay_px, int(2 * depth * ppm)) << "two lines, each at least depth long and 2 px wide";
+  EXPECT_EQ(off_line, 0) << "of " << overlay_px << " overlay pixels";
+  // switched off, and on a frame without an angle: no overlay pixel at all
+  for (const std::string& p : {off, none}) {
+    const auto other = furrow::render::read_png(p);
+    int n = 0;
+    for (int y = 0; y < other.height; ++y)
+      for (int x = 0; x < shot["panel_x0"].get<int>(); ++x) n += magenta(other.at(x, y));
+    EXPECT_EQ(n, 0) << p;
+  }
+  // a run without a wedge analysis says so, naming its run.json
+  const StoredRun stored(dir_ / "plain");
+  r = run({"inspect", (dir_ / "plain").string(), "--headless", "--script", script("wedge\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("run.json holds no wedge analysis"), std::string::npos) << r.err;
 }
 
 TEST_F(InspectCli, BadScriptLinesNameFileLineAndWhatWasExpected) {

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "engine/analysis.hpp"
+#include "engine/field_store.hpp"
 #include "engine/run.hpp"
 #include "tests/engine/test_scenes.hpp"
 
@@ -206,6 +207,10 @@ TEST_P(WedgeAngle, RecoversApexAngleAndHeightOfARasterizedWedge) {
     EXPECT_NEAR(m.apex_angle_deg, apex, 0.5) << "face " << face_y;
     EXPECT_NEAR(m.left_flank_deg, m.right_flank_deg, 0.5);
     EXPECT_NEAR(m.apex_depth_m, H, 0.25 * kDx) << "face " << face_y;
+    // the flank lines meet the face at the plate's corners (what the inspector's overlay draws)
+    EXPECT_NEAR(m.left_flank_x_m, kFaceX0, 0.25 * kDx) << "face " << face_y;
+    EXPECT_NEAR(m.right_flank_x_m, kFaceX0 + kL, 0.25 * kDx) << "face " << face_y;
+    EXPECT_DOUBLE_EQ(m.face_y_m, face_y);
     EXPECT_NEAR(m.height_m, H - 0.5 * kDx / std::tan(half), 0.5 * kDx + 1e-9) << "face " << face_y;
     EXPECT_GE(m.fit_rows, 8);
     // region = the wedge's cells: its area is L H / 2 within a perimeter's worth of cells
@@ -315,7 +320,14 @@ TEST(RunAnalysis, RunJsonHasDragStatisticsAndWedgePerFrame) {
   RunOptions opt;
   opt.out_dir = dir;
   opt.write_paraview = false;
+  // a follower sees each frame complete as it is stored, numbered in order
+  int64_t written = 0;
+  opt.frame_written = [&](int64_t index, const std::string& path) {
+    EXPECT_EQ(index, written++);
+    EXPECT_FALSE(read_frame(path).velocity_x.empty()) << path;  // the stored field is there
+  };
   const RunSummary r = run_scene(s, opt);
+  EXPECT_EQ(written, r.run_json.at("frames").get<int64_t>());
   const auto& a = r.run_json.at("analysis");
   EXPECT_EQ(a.at("lead_body"), "plate");
   const auto& d = a.at("drag");
@@ -325,7 +337,16 @@ TEST(RunAnalysis, RunJsonHasDragStatisticsAndWedgePerFrame) {
   EXPECT_GT(d.at("mean_N_per_m").get<double>(), 0.0);
   const auto& w = a.at("wedge");
   EXPECT_EQ(w.at("frames").size(), size_t(r.run_json.at("frames").get<int64_t>()));
-  for (const auto& e : w.at("frames")) EXPECT_TRUE(e.contains("apex_angle_deg") && e.contains("height_m"));
+  for (const auto& e : w.at("frames")) {
+    EXPECT_TRUE(e.contains("apex_angle_deg") && e.contains("height_m"));
+    // a frame with an angle carries its flank lines, consistent with it
+    if (e.at("apex_angle_deg").is_number()) {
+      EXPECT_NEAR(e.at("left_flank_deg").get<double>() + e.at("right_flank_deg").get<double>(),
+                  e.at("apex_angle_deg").get<double>(), 1e-9);
+      EXPECT_LT(e.at("left_flank_x_m").get<double>(), e.at("right_flank_x_m").get<double>());
+      EXPECT_TRUE(e.at("face_y_m").is_number());
+    }
+  }
   EXPECT_TRUE(w.contains("early_median_apex_angle_deg") && w.contains("late_median_apex_angle_deg"));
   std::ifstream in(dir + "/run.json");
   EXPECT_EQ(nlohmann::json::parse(in).at("analysis"), a);
