@@ -120,7 +120,7 @@ std::string scene_summary(const Scene& s, const std::string& source) {
   for (const auto& b : s.bodies)
     os << "  body       " << b.name << ": " << kShapeNames[int(b.shape.kind)] << ", max speed "
        << fmt("%g", motion_max_speed_m_s(b.motion)) << " m/s, "
-       << (s.solver.contact == ContactMethod::Particle ? "particle" : "node") << " contact\n";
+       << contact_method_name(s.solver.contact) << " contact\n";
   os << "  time step  ~" << fmt("%.3g", dt) << " s (cfl " << fmt("%g", s.solver.cfl) << ")\n";
   os << "  end        t = " << fmt("%.4g", t_end) << " s";
   const int ref = reference_body_index(s);

@@ -15,7 +15,9 @@ enum class MaterialModel { NDPM, DPM };
 // How bodies act on the media: on the grid nodes inside them (default; the force steps each time a
 // face crosses a node line), or on the material points touching their surface (smooth, but the
 // constraint spreads over the points' B-spline stencils: a body acts about a cell larger).
-enum class ContactMethod { Node, Particle };
+enum class ContactMethod { Node, Particle, CellFraction };
+// The scene file's name of a contact method ("node", "particle", "cell_fraction").
+const char* contact_method_name(ContactMethod method);
 
 struct Material {
   std::string name = "sand";

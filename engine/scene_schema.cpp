@@ -127,7 +127,7 @@ const KeyList kShapeTypes = {"circle", "box", "polygon", "union"};  // Shape::Ki
 const KeyList kMotionTypes = {"constant_velocity", "path"};
 const KeyList kWallTypes = {"slip", "friction", "sticky", "open"};
 const KeyList kShapeFunctions = {"linear", "quadratic", "cubic"};
-const KeyList kContactMethods = {"node", "particle"};  // ContactMethod order
+const KeyList kContactMethods = {"node", "particle", "cell_fraction"};  // ContactMethod order
 
 KeyList merged(std::initializer_list<const KeyList*> lists) {
   KeyList out;
@@ -281,5 +281,7 @@ std::vector<std::string> schema_keys(const json& root, const std::string& pointe
   }
   return {};
 }
+
+const char* contact_method_name(ContactMethod method) { return scene_detail::kContactMethods.at(size_t(method)).c_str(); }
 
 }  // namespace furrow

@@ -24,6 +24,8 @@ constexpr size_t kGrain = 4096;  // particles per TBB task
 // particles G2P and the constitutive update take in turn when fused: their ~20 arrays of a block
 // stay in L2 (256 points x 20 x 8 B = 40 kB)
 constexpr size_t kFusedBlock = 256;
+// cell-fraction contact: where its ramp ends outside the surface, in cells (see contact_nodes)
+constexpr double kFractionReach = 0.75;
 
 // The P2G strip of `cells` cell columns holding x; strip 0 and the last take the grid margins.
 inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
@@ -68,8 +70,11 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   auto pick = [&](auto kernel) {
     using K = decltype(kernel);
     p2g_ = flip_ ? &Simulation::particles_to_grid<K, true> : &Simulation::particles_to_grid<K, false>;
-    contact_ = scene_.solver.contact == ContactMethod::Particle ? &Simulation::contact_particles<K>
-                                                                 : &Simulation::contact_nodes;
+    switch (scene_.solver.contact) {
+      case ContactMethod::Node: contact_ = &Simulation::contact_nodes<false>; break;
+      case ContactMethod::Particle: contact_ = &Simulation::contact_particles<K>; break;
+      case ContactMethod::CellFraction: contact_ = &Simulation::contact_nodes<true>; break;
+    }
     g2p_range_ = flip_ ? &Simulation::g2p_range<K, true> : &Simulation::g2p_range<K, false>;
   };
   switch (scene_.solver.shape_function) {
@@ -371,26 +376,46 @@ void Simulation::bodies_and_walls() {
 // Node contact: every grid node inside a body takes the body's normal velocity (Coulomb slip
 // along it). The constrained set grows by a node row each time a face crosses a node line, so
 // the force steps with a period of one cell.
+//
+// Cell-fraction contact (Fraction): a node takes the share f = clamp(kFractionReach - d/dx, 0, 1)
+// of that correction, d its signed distance to the surface (f: 0 three quarters of a cell outside,
+// 1 a quarter cell inside). f moves with the body, so no node switches on at once as a face crosses
+// a node line. Its normal is the material's: the mass gradient across the node, as in multi-field
+// contact (Bardenhagen et al. 2001). The body's own nearest-face normal flips at its medial axis,
+// which in a plate two cells thick is a node row: that row then stops holding the material below
+// it, which made the larger part of the node method's comb. The ramp's place was measured
+// (README, "Body contact"): centred on the surface the force is more accurate but keeps a 3.6%
+// comb; a quarter cell further out it is 1.8% for +5% force; half a cell, smoother still, +10%.
+template <bool Fraction>
 void Simulation::contact_nodes() {
   const double dt = dt_s_, dx = g_.dx;
+  const int lo = -Grid::kPad, hi_i = g_.nx + Grid::kPad, hi_j = g_.ny + Grid::kPad;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const Body& body = scene_.bodies[b];
     BodyState& s = bodies_[b];
     const double mu = scene_.effects.body_friction ? body.friction : 0.0;
-    const int i0 = std::max(-Grid::kPad, int(std::floor((s.position_m.x() + s.lo_m.x()) / dx)) - 1);
-    const int i1 = std::min(g_.nx + Grid::kPad, int(std::ceil((s.position_m.x() + s.hi_m.x()) / dx)) + 1);
-    const int j0 = std::max(-Grid::kPad, int(std::floor((s.position_m.y() + s.lo_m.y()) / dx)) - 1);
-    const int j1 = std::min(g_.ny + Grid::kPad, int(std::ceil((s.position_m.y() + s.hi_m.y()) / dx)) + 1);
+    const int i0 = std::max(lo, int(std::floor((s.position_m.x() + s.lo_m.x()) / dx)) - 1);
+    const int i1 = std::min(hi_i, int(std::ceil((s.position_m.x() + s.hi_m.x()) / dx)) + 1);
+    const int j0 = std::max(lo, int(std::floor((s.position_m.y() + s.lo_m.y()) / dx)) - 1);
+    const int j1 = std::min(hi_j, int(std::ceil((s.position_m.y() + s.hi_m.y()) / dx)) + 1);
     Vec2 impulse(0.0, 0.0);
     for (int j = j0; j <= j1; ++j)
       for (int i = i0; i <= i1; ++i) {
         GridNode& n = g_.node[g_.index(i, j)];
         if (n.m <= 0.0) continue;
         const Vec2 q = Vec2(i * dx, j * dx) - s.position_m;
-        if (shape_sdf(body.shape, q) >= 0.0) continue;
+        const double d = shape_sdf(body.shape, q);
+        if (d >= (Fraction ? kFractionReach * dx : 0.0)) continue;
+        Vec2 normal = shape_normal(body.shape, q, 1e-4 * dx);
+        if constexpr (Fraction) {
+          auto m = [&](int a, int c) { return g_.node[g_.index(std::clamp(a, lo, hi_i), std::clamp(c, lo, hi_j))].m; };
+          const Vec2 grad(m(i + 1, j) - m(i - 1, j), m(i, j + 1) - m(i, j - 1));
+          if (grad.squaredNorm() > 0.0) normal = grad.normalized();
+        }
         Vec2 v(n.vx, n.vy);
         const Vec2 before = v;
-        if (!contact(v, s.velocity_m_s, shape_normal(body.shape, q, 1e-4 * dx), mu)) continue;
+        if (!contact(v, s.velocity_m_s, normal, mu)) continue;
+        if constexpr (Fraction) v = before + std::min(1.0, kFractionReach - d / dx) * (v - before);
         impulse += n.m * (v - before);
         n.vx = v.x();
         n.vy = v.y();

@@ -136,7 +136,7 @@ class Simulation {
   template <class Kernel> void find_contact_points();
   template <class Kernel> void solve_contact_points();
   template <class Kernel> void apply_contact_impulse(const ContactPoint& c, const Vec2& J);
-  void contact_nodes();
+  template <bool Fraction> void contact_nodes();
   void contact_walls();
   void front_back_friction();
   struct G2PLocal {

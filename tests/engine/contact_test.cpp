@@ -74,6 +74,27 @@ TEST(ContactSmoothness, LooseIntrusionHasNoSpikes) {
   EXPECT_LE(f.cell_amplitude_relative, 0.02);
 }
 
+// Cell-fraction contact on the same two templates. plate_intrusion: 1.11x, RMS 2.2%, cell
+// component 1.8% (node 1.46x, 8.9%, 7.8%); what is left in the RMS has the bed's elastic periods,
+// as with particle contact. loose_intrusion: 1.12x from three cells of penetration (node 4.8x).
+TEST(ContactSmoothness, CellFractionPlateIntrusionHasNoCellComb) {
+  const Trace t = run_template("plate_intrusion", 0.0855, ContactMethod::CellFraction);
+  const ForceSmoothness f = force_smoothness(t.travel_m, t.drag_N_per_m, t.dx_m, 0.045, 0.085);
+  report("plate_intrusion, cell_fraction", f);
+  EXPECT_LE(f.peak_ratio, 1.15);
+  EXPECT_LE(f.cell_amplitude_relative, 0.02);
+  EXPECT_LE(f.rms_relative, 0.03);
+}
+
+TEST(ContactSmoothness, CellFractionLooseIntrusionHasNoSpikes) {
+  const Trace t = run_template("loose_intrusion", 0.035, ContactMethod::CellFraction);
+  const double gap = 0.002, dx = t.dx_m;
+  const ForceSmoothness f = force_smoothness(t.travel_m, t.drag_N_per_m, dx, gap + 3 * dx, t.travel_m.back() - 0.5 * dx);
+  report("loose_intrusion, cell_fraction", f);
+  EXPECT_LE(f.peak_ratio, 1.2);
+  EXPECT_LE(f.cell_amplitude_relative, 0.04);
+}
+
 // Onset: a 0.04 m plate descending at 0.1 m/s from 2 cells (10 mm) above a bed, dx 5 mm. Until
 // its face is within a quarter cell of the material's surface it feels less than 1% of its force
 // after one cell of penetration (measured: exactly 0 of 189 N/m); node contact feels the bed

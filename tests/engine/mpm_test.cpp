@@ -99,7 +99,7 @@ TEST(Mpm, RigidTranslationLeavesStressUnchanged) {
 }
 
 TEST(Mpm, OneAndTwoThreadsGiveIdenticalResults) {
-  for (ContactMethod contact : {ContactMethod::Node, ContactMethod::Particle}) {
+  for (ContactMethod contact : {ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction}) {
     Scene s = bed_scene(0.2, 0.1, 0.03, 0.005, 1.0);
     s.bodies.push_back(plate(0.04, 0.01, 0.1, 0.101, Vec2(0.0, -0.2)));
     s.solver.contact = contact;
@@ -250,7 +250,7 @@ class BodyContact : public ::testing::TestWithParam<double> {};
 
 TEST_P(BodyContact, NoParticleInsideBodyByMoreThanAQuarterCell) {
   const double speed = GetParam(), dx = 0.005;
-  for (ContactMethod contact : {ContactMethod::Node, ContactMethod::Particle}) {
+  for (ContactMethod contact : {ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction}) {
     const PlateRun r = run_plate(speed, 0.4, 0.03, contact);
     EXPECT_LT(r.max_penetration_m, 0.25 * dx) << "speed " << speed << ", contact " << int(contact);
     EXPECT_GT(window_mean(r, 0.02, 0.03), 0.0);
@@ -262,7 +262,7 @@ INSTANTIATE_TEST_SUITE_P(Speeds, BodyContact, ::testing::Values(0.1, 2.0));
 // With no gravity and no walls, everything the media gains comes from the body: per step the
 // media's momentum change equals minus the body's force times dt.
 TEST(BodyContact, BodyForceBalancesMediaMomentum) {
-  for (ContactMethod contact : {ContactMethod::Node, ContactMethod::Particle}) {
+  for (ContactMethod contact : {ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction}) {
     Scene s = floating_block(ShapeFunction::Quadratic);
     s.bodies.push_back(plate(0.04, 0.01, 0.1, 0.121, Vec2(0.0, -0.5)));
     s.solver.contact = contact;

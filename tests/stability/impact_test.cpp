@@ -44,7 +44,7 @@ TEST_P(StiffBed, PlateImpactStaysBounded) {
   EXPECT_GT(f_max, 2520.0 * 0.6 * kG * 0.04 * depth_m);
 }
 
-INSTANTIATE_TEST_SUITE_P(Contact, StiffBed, ::testing::Values(ContactMethod::Node, ContactMethod::Particle),
+INSTANTIATE_TEST_SUITE_P(Contact, StiffBed, ::testing::Values(ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction),
                          [](const auto& info) { return label(info.param); });
 
 // ----------------------------------------------------------------------------- (2) fast impact
@@ -79,7 +79,7 @@ TEST_P(FastImpact, RodAtFiveMetresPerSecond) {
   EXPECT_GT(check.bodies_work_J(), 0.0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Contact, FastImpact, ::testing::Values(ContactMethod::Node, ContactMethod::Particle),
+INSTANTIATE_TEST_SUITE_P(Contact, FastImpact, ::testing::Values(ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction),
                          [](const auto& info) { return label(info.param); });
 
 // ----------------------------------------------------------------------------- (3) free fall

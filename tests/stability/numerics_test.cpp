@@ -51,7 +51,7 @@ TEST_P(OnePerCell, PlateIntoBed) {
   EXPECT_GT(f_max, min_push_N_per_m());
 }
 
-INSTANTIATE_TEST_SUITE_P(Contact, OnePerCell, ::testing::Values(ContactMethod::Node, ContactMethod::Particle),
+INSTANTIATE_TEST_SUITE_P(Contact, OnePerCell, ::testing::Values(ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction),
                          [](const auto& info) { return std::string(contact_name(info.param)); });
 
 // ----------------------------------------------------------------------------- (8) CFL limit
@@ -78,7 +78,7 @@ TEST_P(CflLimit, PlateIntoBedAtCflOne) {
 INSTANTIATE_TEST_SUITE_P(KernelsAndContact, CflLimit,
                          ::testing::Combine(::testing::Values(ShapeFunction::Linear, ShapeFunction::Quadratic,
                                                               ShapeFunction::Cubic),
-                                            ::testing::Values(ContactMethod::Node, ContactMethod::Particle)),
+                                            ::testing::Values(ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction)),
                          [](const auto& info) {
                            return std::string(shape_name(std::get<0>(info.param))) + "_" +
                                   contact_name(std::get<1>(info.param));

@@ -45,7 +45,7 @@ inline Scene from_template(const std::string& name, std::vector<std::string> ove
   return parse_scene_text(t->text, "<template " + name + ">", overrides);
 }
 
-inline const char* contact_name(ContactMethod c) { return c == ContactMethod::Node ? "node" : "particle"; }
+inline const char* contact_name(ContactMethod c) { return contact_method_name(c); }
 inline const char* shape_name(ShapeFunction f) {
   return f == ShapeFunction::Linear ? "linear" : f == ShapeFunction::Quadratic ? "quadratic" : "cubic";
 }
