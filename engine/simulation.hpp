@@ -137,6 +137,7 @@ class Simulation {
   template <class Kernel> void solve_contact_points();
   template <class Kernel> void apply_contact_impulse(const ContactPoint& c, const Vec2& J);
   template <bool Fraction> void contact_nodes();
+  template <class Kernel> void contact_cell_fraction();
   void contact_walls();
   void front_back_friction();
   struct G2PLocal {
@@ -175,6 +176,7 @@ class Simulation {
   bool fuse_particle_passes_ = true;
   void (Simulation::*contact_)() = nullptr;
   std::vector<ContactPoint> contacts_;
+  std::vector<std::vector<uint8_t>> touched_;  // cell-fraction contact: per body, per node
   std::vector<std::vector<uint32_t>> contact_chunks_;
   std::unique_ptr<tbb::task_arena> arena_;
 };
