@@ -22,7 +22,8 @@ namespace {
 
 constexpr size_t kGrain = 4096;  // particles per TBB task
 // particles G2P and the constitutive update take in turn when fused: their ~20 arrays of a block
-// stay in L2 (256 points x 20 x 8 B = 40 kB)
+// stay in L2 (256 points x 20 x 8 B = 40 kB). Measured alone this gains nothing (README,
+// Performance); it is the shape a fused G2P + constitutive + next P2G pass would take.
 constexpr size_t kFusedBlock = 256;
 // cell-fraction contact: where its ramp ends outside the surface, in cells (see contact_nodes)
 constexpr double kFractionReach = 0.75;
@@ -819,7 +820,7 @@ void Simulation::constitutive_range(size_t begin, size_t end) {
 }
 
 // G2P and the constitutive update. Fused, each block of particles gets both while it is in cache
-// (one trip through memory per step instead of two; the same arithmetic, so the same bits); apart
+// (the same arithmetic, so the same bits; no faster on its own, README); apart
 // when the front/back walls' friction must act between them, or for a profile of each phase.
 void Simulation::particles_update(bool g2p, bool constitutive) {
   const size_t nb = bodies_.size();
