@@ -36,6 +36,24 @@ inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
   return std::clamp(int(std::floor(x_m * inv_dx)) / cells + 1, 0, strips - 1);
 }
 
+// The grid nodes a body's box covers, one node of margin, clipped to the padded grid. One
+// function for every contact pass, so a node one pass marks is a node another pass visits.
+struct NodeBox {
+  int i0, i1, j0, j1;
+};
+inline NodeBox body_node_box(const BodyState& s, const Grid& g) {
+  const double inv_dx = 1.0 / g.dx;
+  const Vec2 lo = (s.position_m + s.lo_m) * inv_dx, hi = (s.position_m + s.hi_m) * inv_dx;
+  return {std::max(-Grid::kPad, int(std::floor(lo.x())) - 1), std::min(g.nx + Grid::kPad, int(std::ceil(hi.x())) + 1),
+          std::max(-Grid::kPad, int(std::floor(lo.y())) - 1), std::min(g.ny + Grid::kPad, int(std::ceil(hi.y())) + 1)};
+}
+
+// The first and last P2G strips holding points within `reach_m` of a body's box.
+inline std::pair<int, int> body_strip_span(const BodyState& s, double reach_m, double inv_dx, int cells, int strips) {
+  return {strip_index(s.position_m.x() + s.lo_m.x() - reach_m, inv_dx, cells, strips),
+          strip_index(s.position_m.x() + s.hi_m.x() + reach_m, inv_dx, cells, strips)};
+}
+
 }  // namespace
 
 Simulation::Simulation(const Scene& scene) : scene_(scene) {
@@ -399,10 +417,7 @@ void Simulation::contact_nodes() {
     const Body& body = scene_.bodies[b];
     BodyState& s = bodies_[b];
     const double mu = scene_.effects.body_friction ? body.friction : 0.0;
-    const int i0 = std::max(lo, int(std::floor((s.position_m.x() + s.lo_m.x()) / dx)) - 1);
-    const int i1 = std::min(hi_i, int(std::ceil((s.position_m.x() + s.hi_m.x()) / dx)) + 1);
-    const int j0 = std::max(lo, int(std::floor((s.position_m.y() + s.lo_m.y()) / dx)) - 1);
-    const int j1 = std::min(hi_j, int(std::ceil((s.position_m.y() + s.hi_m.y()) / dx)) + 1);
+    const auto [i0, i1, j0, j1] = body_node_box(s, g_);
     Vec2 impulse(0.0, 0.0);
     for (int j = j0; j <= j1; ++j)
       for (int i = i0; i <= i1; ++i) {
@@ -449,12 +464,8 @@ void Simulation::contact_cell_fraction() {
     auto& touched = touched_[b];
     touched.resize(g_.node.size(), 0);
     // only nodes contact_nodes() visits are marked, so it also clears every mark it leaves behind
-    const int i0 = std::max(-Grid::kPad, int(std::floor((s.position_m.x() + s.lo_m.x()) * inv_dx)) - 1);
-    const int i1 = std::min(g_.nx + Grid::kPad, int(std::ceil((s.position_m.x() + s.hi_m.x()) * inv_dx)) + 1);
-    const int j0 = std::max(-Grid::kPad, int(std::floor((s.position_m.y() + s.lo_m.y()) * inv_dx)) - 1);
-    const int j1 = std::min(g_.ny + Grid::kPad, int(std::ceil((s.position_m.y() + s.hi_m.y()) * inv_dx)) + 1);
-    const int first = strip_index(s.position_m.x() + s.lo_m.x() - reach, inv_dx, kStripCells, strips);
-    const int last = strip_index(s.position_m.x() + s.hi_m.x() + reach, inv_dx, kStripCells, strips);
+    const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+    const auto [first, last] = body_strip_span(s, reach, inv_dx, kStripCells, strips);
     for (uint32_t k = strip_start_[first]; k < strip_start_[last + 1]; ++k) {
       const uint32_t p = order_[k];
       const Vec2 q = Vec2(p_.x[p], p_.y[p]) - s.position_m;
@@ -497,8 +508,7 @@ void Simulation::find_contact_points() {
   std::vector<std::pair<int, int>> spans(nb);
   for (size_t b = 0; b < nb; ++b) {
     const BodyState& s = bodies_[b];
-    spans[b] = {strip_index(s.position_m.x() + s.lo_m.x() - reach, inv_dx, kStripCells, strips),
-                strip_index(s.position_m.x() + s.hi_m.x() + reach, inv_dx, kStripCells, strips)};
+    spans[b] = body_strip_span(s, reach, inv_dx, kStripCells, strips);
   }
   tbb::parallel_for(size_t(0), contact_chunks_.size(), [&](size_t k) {
     const size_t b = k / size_t(strips);
@@ -826,10 +836,10 @@ void Simulation::particles_update(bool g2p, bool constitutive) {
   const size_t nb = bodies_.size();
   tbb::enumerable_thread_specific<G2PLocal> locals([&] { return G2PLocal{std::vector<Vec2>(nb, Vec2(0, 0))}; });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, p_.size(), kGrain), [&](const auto& r) {
-    G2PLocal& loc = locals.local();
+    G2PLocal* loc = g2p ? &locals.local() : nullptr;  // the constitutive-only pass makes none
     for (size_t b = r.begin(); b < r.end(); b += kFusedBlock) {
       const size_t e = std::min(r.end(), b + kFusedBlock);
-      if (g2p) (this->*g2p_range_)(b, e, loc);
+      if (g2p) (this->*g2p_range_)(b, e, *loc);
       if (constitutive) (this->*constitutive_range_)(b, e);
     }
   });
