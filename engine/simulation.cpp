@@ -888,22 +888,25 @@ void Simulation::reorder_particles() {
       return a.particle != b.particle ? a.particle < b.particle : a.body < b.body;
     });
   }
-  auto permute = [&](auto& a) {
-    if (a.empty()) return;
-    std::remove_reference_t<decltype(a)> tmp(a.size());
-    for (size_t i = 0; i < n; ++i) tmp[i] = a[perm[i]];
-    a.swap(tmp);
-  };
+  // One gather buffer for all arrays: each array swaps its storage into it and the old storage
+  // takes the next array. A fresh buffer per array page-faulted ~15 MB each at 1.84M points
+  // (the reorder was 9% of a step there).
   std::vector<std::vector<double>*> arrays = {&p_.x, &p_.y, &p_.vx, &p_.vy, &p_.c00, &p_.c01, &p_.c10,
                                               &p_.c11, &p_.mass, &p_.volume, &p_.sxx, &p_.syy, &p_.sxy,
                                               &p_.szz, &p_.pressure, &p_.phi_d, &p_.plastic_strain,
                                               &p_.strain_rate};
-  tbb::parallel_for(size_t(0), arrays.size() + 1, [&](size_t k) {
-    if (k < arrays.size())
-      permute(*arrays[k]);
-    else
-      permute(p_.material);
-  });
+  std::vector<double> buffer(n);
+  const tbb::blocked_range<size_t> all(0, n, size_t(1) << 14);
+  for (auto* a : arrays) {
+    if (a->empty()) continue;
+    tbb::parallel_for(all, [&](const auto& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) buffer[i] = (*a)[perm[i]];
+    });
+    a->swap(buffer);
+  }
+  std::vector<uint8_t> material(n);
+  for (size_t i = 0; i < n; ++i) material[i] = p_.material[perm[i]];
+  p_.material.swap(material);
 }
 
 size_t Simulation::state_bytes() const {
