@@ -24,7 +24,7 @@ Scene collapse_template(std::vector<std::string> sets) {
 }
 
 // The test resolution: dx 4 mm, a quarter of the template's cost per step and half its steps (the
-// template's 2 mm is where the runout has converged; 4 mm runs 7% shorter, README).
+// template's 2 mm is where the runout has converged; 4 mm runs 5-7% shorter, README).
 const std::string kTestDx = "domain.dx_m=0.004";
 // A column twice as tall as wide in a domain that holds its runout. The fronts stop by 0.44 s
 // (a = 1) and 0.58 s (a = 2) at this dx; `settled` checks that the runs were long enough.
