@@ -322,28 +322,11 @@ void Simulation::particles_to_grid() {
         q11 += s11;
       }
       const double dx0 = bx * dx - xp, dy0 = by * dx - yp;
-      if constexpr (K::mls && Flip) {
-        // the node's first four fields (m, momentum, force impulse x) as one 4-wide update,
-        // w * (base + dxp colA + dyp colB): the scalar loop's sums, rounded differently in the
-        // last bits; -30% P2G time (README, Performance)
-        typedef double v4 __attribute__((vector_size(32)));
-        const v4 base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
-        for (int b = 0; b < K::N; ++b) {
-          GridNode* row = grid + g_.index(bx, by + b);
-          const double dyp = dy0 + b * dx;
-          for (int a = 0; a < K::N; ++a) {
-            const double dxp = dx0 + a * dx;
-            const double w = wx[a] * wy[b];
-            GridNode& n = row[a];
-            v4 cur;
-            std::memcpy(&cur, &n.m, sizeof cur);
-            cur += w * (base + dxp * colA + dyp * colB);
-            std::memcpy(&n.m, &cur, sizeof cur);
-            n.vy0 += w * (s01 * dxp + s11 * dyp);
-          }
-        }
-        continue;
-      }
+      // FLIP with MLS kernels (the default path): the node's first four fields (m, momentum,
+      // force impulse x) as one 4-wide update, w (base + dxp colA + dyp colB): the scalar sums
+      // below, rounded differently in the last bits; -30% P2G time (README, Performance)
+      typedef double v4 __attribute__((vector_size(32)));
+      [[maybe_unused]] const v4 base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
       for (int b = 0; b < K::N; ++b) {
         GridNode* row = grid + g_.index(bx, by + b);
         const double dyp = dy0 + b * dx;
@@ -351,6 +334,14 @@ void Simulation::particles_to_grid() {
           const double dxp = dx0 + a * dx;
           const double w = wx[a] * wy[b];
           GridNode& n = row[a];
+          if constexpr (K::mls && Flip) {
+            v4 cur;
+            std::memcpy(&cur, &n.m, sizeof cur);
+            cur += w * (base + dxp * colA + dyp * colB);
+            std::memcpy(&n.m, &cur, sizeof cur);
+            n.vy0 += w * (s01 * dxp + s11 * dyp);
+            continue;
+          }
           n.m += w * m;
           n.vx += w * (mvx + q00 * dxp + q01 * dyp);
           n.vy += w * (mvy + q10 * dxp + q11 * dyp);
