@@ -324,7 +324,7 @@ void Simulation::particles_to_grid() {
       const double dx0 = bx * dx - xp, dy0 = by * dx - yp;
       // FLIP with MLS kernels (the default path): the node's first four fields (m, momentum,
       // force impulse x) as one 4-wide update, w (base + dxp colA + dyp colB): the scalar sums
-      // below, rounded differently in the last bits; -30% P2G time (README, Performance)
+      // below, rounded differently in the last bits (gain measured in README, Performance)
       typedef double v4 __attribute__((vector_size(32)));
       [[maybe_unused]] const v4 base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
       for (int b = 0; b < K::N; ++b) {
@@ -764,7 +764,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
       // 4-wide (FLIP, MLS kernels: the default path): [vx vy ox oy] += w [n.vx n.vy n.vx0 n.vy0]
       // (the node's last four fields) and [b00 b01 b10 b11] += w [gvx gvx gvy gvy] [dxp dyp dxp
       // dyp]. Same sums as the scalar loop below, rounded differently (FMA contraction) in the
-      // last bits; -28% G2P time (README, Performance)
+      // last bits (gain measured in README, Performance)
       typedef double v4 __attribute__((vector_size(32)));
       typedef long long m4 __attribute__((vector_size(32)));
       v4 vel = {0, 0, 0, 0}, aff = {0, 0, 0, 0};
@@ -935,8 +935,7 @@ void Simulation::reorder_particles() {
     });
   }
   // One gather buffer for all arrays: each array swaps its storage into it and the old storage
-  // takes the next array. A fresh buffer per array page-faulted ~15 MB each at 1.84M points
-  // (the reorder was 9% of a step there).
+  // takes the next array. A fresh buffer per array page-faulted ~15 MB each at 1.84M points.
   std::vector<std::vector<double>*> arrays = {&p_.x, &p_.y, &p_.vx, &p_.vy, &p_.c00, &p_.c01, &p_.c10,
                                               &p_.c11, &p_.mass, &p_.volume, &p_.sxx, &p_.syy, &p_.sxy,
                                               &p_.szz, &p_.pressure, &p_.phi_d, &p_.plastic_strain,
