@@ -38,6 +38,8 @@ constexpr double kTouchCells = 0.2;
 static_assert(sizeof(GridNode) == 5 * sizeof(double) && offsetof(GridNode, vx) == sizeof(double) &&
                   offsetof(GridNode, vy0) == 4 * sizeof(double),
               "GridNode's fields are read four at a time");
+typedef double Vec4d __attribute__((vector_size(32)));
+typedef long long Lanes4 __attribute__((vector_size(32)));
 
 // The P2G strip of `cells` cell columns holding x; strip 0 and the last take the grid margins.
 inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
@@ -325,8 +327,7 @@ void Simulation::particles_to_grid() {
       // FLIP with MLS kernels (the default path): the node's first four fields (m, momentum,
       // force impulse x) as one 4-wide update, w (base + dxp colA + dyp colB): the scalar sums
       // below, rounded differently in the last bits (gain measured in README, Performance)
-      typedef double v4 __attribute__((vector_size(32)));
-      [[maybe_unused]] const v4 base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
+      [[maybe_unused]] const Vec4d base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
       for (int b = 0; b < K::N; ++b) {
         GridNode* row = grid + g_.index(bx, by + b);
         const double dyp = dy0 + b * dx;
@@ -335,7 +336,7 @@ void Simulation::particles_to_grid() {
           const double w = wx[a] * wy[b];
           GridNode& n = row[a];
           if constexpr (K::mls && Flip) {
-            v4 cur;
+            Vec4d cur;
             std::memcpy(&cur, &n.m, sizeof cur);
             cur += w * (base + dxp * colA + dyp * colB);
             std::memcpy(&n.m, &cur, sizeof cur);
@@ -760,59 +761,51 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
     const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
     const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
     double vx = 0, vy = 0, b00 = 0, b01 = 0, b10 = 0, b11 = 0, ox = 0, oy = 0;
-    if constexpr (K::mls && Flip) {
-      // 4-wide (FLIP, MLS kernels: the default path): [vx vy ox oy] += w [n.vx n.vy n.vx0 n.vy0]
-      // (the node's last four fields) and [b00 b01 b10 b11] += w [gvx gvx gvy gvy] [dxp dyp dxp
-      // dyp]. Same sums as the scalar loop below, rounded differently (FMA contraction) in the
-      // last bits (gain measured in README, Performance)
-      typedef double v4 __attribute__((vector_size(32)));
-      typedef long long m4 __attribute__((vector_size(32)));
-      v4 vel = {0, 0, 0, 0}, aff = {0, 0, 0, 0};
-      for (int b = 0; b < K::N; ++b) {
-        const GridNode* row = &g_.node[g_.index(bx, by + b)];
-        const double dyp = (by + b) * dx - yp;
-        for (int a = 0; a < K::N; ++a) {
-          const double w = wx[a] * wy[b];
+    // 4-wide on the default path (FLIP, MLS kernels): [vx vy ox oy] += w [n.vx n.vy n.vx0 n.vy0]
+    // (the node's last four fields) and [b00 b01 b10 b11] += w [gvx gvx gvy gvy] [dxp dyp dxp
+    // dyp]. Same sums as the scalar lines, rounded differently (FMA contraction) in the last bits
+    // (gain measured in README, Performance)
+    [[maybe_unused]] Vec4d vel = {0, 0, 0, 0}, aff = {0, 0, 0, 0};
+    for (int b = 0; b < K::N; ++b) {
+      const GridNode* row = &g_.node[g_.index(bx, by + b)];
+      const double dyp = (by + b) * dx - yp;
+      for (int a = 0; a < K::N; ++a) {
+        const double w = wx[a] * wy[b];
+        const GridNode& n = row[a];
+        if constexpr (K::mls && Flip) {
           const double dxp = (bx + a) * dx - xp;
-          v4 g;
-          std::memcpy(&g, &row[a].vx, sizeof g);
-          const v4 wg = w * g;
+          Vec4d g;
+          std::memcpy(&g, &n.vx, sizeof g);
+          const Vec4d wg = w * g;
           vel += wg;
-          aff += __builtin_shuffle(wg, m4{0, 0, 1, 1}) * v4{dxp, dyp, dxp, dyp};
+          aff += __builtin_shuffle(wg, Lanes4{0, 0, 1, 1}) * Vec4d{dxp, dyp, dxp, dyp};
+          continue;
+        }
+        const double gvx = n.vx, gvy = n.vy;
+        vx += w * gvx;
+        vy += w * gvy;
+        if constexpr (Flip) {
+          ox += w * n.vx0;
+          oy += w * n.vy0;
+        }
+        if constexpr (K::mls) {
+          const double dxp = (bx + a) * dx - xp;
+          b00 += w * gvx * dxp;
+          b01 += w * gvx * dyp;
+          b10 += w * gvy * dxp;
+          b11 += w * gvy * dyp;
+        } else {
+          const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
+          b00 += gvx * gxw;
+          b01 += gvx * gyw;
+          b10 += gvy * gxw;
+          b11 += gvy * gyw;
         }
       }
+    }
+    if constexpr (K::mls && Flip) {
       vx = vel[0], vy = vel[1], ox = vel[2], oy = vel[3];
       b00 = aff[0], b01 = aff[1], b10 = aff[2], b11 = aff[3];
-    } else {
-      for (int b = 0; b < K::N; ++b) {
-        const size_t row = g_.index(bx, by + b);
-        const double dyp = (by + b) * dx - yp;
-        for (int a = 0; a < K::N; ++a) {
-          const size_t node = row + a;
-          const double w = wx[a] * wy[b];
-          const GridNode& n = g_.node[node];
-          const double gvx = n.vx, gvy = n.vy;
-          vx += w * gvx;
-          vy += w * gvy;
-          if constexpr (Flip) {
-            ox += w * n.vx0;
-            oy += w * n.vy0;
-          }
-          if constexpr (K::mls) {
-            const double dxp = (bx + a) * dx - xp;
-            b00 += w * gvx * dxp;
-            b01 += w * gvx * dyp;
-            b10 += w * gvy * dxp;
-            b11 += w * gvy * dyp;
-          } else {
-            const double gxw = dwx[a] * wy[b], gyw = wx[a] * dwy[b];
-            b00 += gvx * gxw;
-            b01 += gvx * gyw;
-            b10 += gvy * gxw;
-            b11 += gvy * gyw;
-          }
-        }
-      }
     }
     const double sc = K::mls ? Dinv : 1.0;
     P.c00[p] = b00 * sc;
