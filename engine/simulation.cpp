@@ -27,8 +27,13 @@ constexpr size_t kGrain = 4096;  // particles per TBB task
 // stay in L2 (256 points x 20 x 8 B = 40 kB). Measured alone this gains nothing (README,
 // Performance); it is the shape a fused G2P + constitutive + next P2G pass would take.
 constexpr size_t kFusedBlock = 256;
-// cell-fraction contact: where its ramp ends outside the surface, in cells (see contact_nodes)
-constexpr double kFractionReach = 0.75;
+// cell-fraction contact: the body as its own mass field (see contact_nodes). Its sample points
+// fill the body deeper than kBodyFieldInset cells, kBodySamplesPerCell per cell and axis, each
+// with kBodyDensityRatio times the bed's mean density. All three were chosen by measurement
+// (README, "Body contact").
+constexpr double kBodyFieldInset = 0.5;
+constexpr int kBodySamplesPerCell = 4;
+constexpr double kBodyDensityRatio = 20.0;
 // cell-fraction contact starts where a point's surface comes this close to a body, in cells (the
 // onset target: nothing until the surfaces are within a quarter cell)
 constexpr double kTouchCells = 0.2;
@@ -97,6 +102,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     bodies_.push_back(s);
   }
   seed_beds();
+  if (scene_.solver.contact == ContactMethod::CellFraction) sample_body_fields();
 
   flip_ = scene_.solver.flip_blend > 0.0;
   auto pick = [&](auto kernel) {
@@ -194,6 +200,34 @@ double Simulation::next_dt_s() const {
   for (size_t b = 0; b < bodies_.size(); ++b)
     vmax = std::max(vmax, motion_velocity_m_s(scene_.bodies[b].motion, t_s_).norm());
   return scene_.solver.cfl * g_.dx / (wave_speed_ + vmax);
+}
+
+// Sample points of each body's mass field (cell-fraction contact), fixed in the body's frame so
+// the field moves smoothly with it. The inset keeps the field's reach (the B-spline support of its
+// outermost points) near the surface; a body thinner than two insets keeps its inner half.
+void Simulation::sample_body_fields() {
+  const double dx = g_.dx, h = dx / kBodySamplesPerCell;
+  double mass = 0.0, volume = 0.0;
+  for (size_t p = 0; p < p_.size(); ++p) mass += p_.mass[p], volume += p_.volume[p];
+  const double density = volume > 0.0 ? kBodyDensityRatio * mass / volume : 0.0;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const BodyState& s = bodies_[b];
+    std::vector<std::pair<Vec2, double>> inside;  // point, depth below the surface (m)
+    double deepest = 0.0;
+    for (double y = s.lo_m.y() + 0.5 * h; y < s.hi_m.y(); y += h)
+      for (double x = s.lo_m.x() + 0.5 * h; x < s.hi_m.x(); x += h) {
+        const double depth = -shape_sdf(scene_.bodies[b].shape, Vec2(x, y));
+        if (depth <= 0.0) continue;
+        inside.emplace_back(Vec2(x, y), depth);
+        deepest = std::max(deepest, depth);
+      }
+    const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
+    std::vector<Vec2> samples;
+    for (const auto& [q, depth] : inside)
+      if (depth >= inset) samples.push_back(q);
+    body_samples_m_.push_back(std::move(samples));
+  }
+  body_sample_mass_kg_ = density * h * h;
 }
 
 void Simulation::step() {
@@ -421,16 +455,14 @@ void Simulation::bodies_and_walls() {
 // along it). The constrained set grows by a node row each time a face crosses a node line, so
 // the force steps with a period of one cell.
 //
-// Cell-fraction contact (Fraction): a node takes the share f = clamp(kFractionReach - d/dx, 0, 1)
-// of that correction, d its signed distance to the surface (f: 0 three quarters of a cell outside,
-// 1 a quarter cell inside). f moves with the body, so no node switches on at once as a face crosses
-// a node line. Its normal is the material's: the mass gradient across the node, as in multi-field
-// contact (Bardenhagen et al. 2001). The body's own nearest-face normal flips at its medial axis,
-// which in a plate two cells thick is a node row: that row then stops holding the material below
-// it, which made the larger part of the node method's comb. The ramp's place was measured
-// (README, "Body contact"): centred on the surface the force is more accurate but keeps a 3.6%
-// comb; a quarter cell further out it is 1.8% for +5% force; half a cell, smoother still, +10%.
-// Nodes act only once touched (contact_cell_fraction).
+// Cell-fraction contact (Fraction): the body is also a mass field on the grid, scattered from
+// sample points fixed in its frame (contact_cell_fraction), and a node takes the share
+// m_body / (m_body + m_media) of the correction, as multi-field contact of the media against a
+// body of finite mass would (Bardenhagen et al. 2001). The share is a smooth function of the
+// body's position, so no node switches on at once as a face crosses a node line. Its normal is
+// the media's mass gradient: the body's own nearest-face normal flips at its medial axis, which
+// in a plate two cells thick is a node row that then stops holding the material below it (the
+// larger part of the node method's comb). Nodes act only once touched (contact_cell_fraction).
 template <bool Fraction>
 void Simulation::contact_nodes() {
   const double dt = dt_s_, dx = g_.dx;
@@ -446,13 +478,18 @@ void Simulation::contact_nodes() {
         const size_t k = g_.index(i, j);
         GridNode& n = g_.node[k];
         const Vec2 q = Vec2(i * dx, j * dx) - s.position_m;
-        const double d = n.m > 0.0 ? shape_sdf(body.shape, q) : 0.0;
-        if (n.m <= 0.0 || d >= (Fraction ? kFractionReach * dx : 0.0)) {
-          if constexpr (Fraction) touched_[b][k] = 0;  // out of reach: must be touched again
+        double share = 1.0;
+        if constexpr (Fraction) {
+          const double m_body = body_node_mass_kg_[b][size_t(j - j0) * size_t(i1 - i0 + 1) + size_t(i - i0)];
+          if (n.m <= 0.0 || m_body <= 0.0) {
+            touched_[b][k] = 0;  // out of the body's reach: must be touched again
+            continue;
+          }
+          if (!touched_[b][k]) continue;
+          share = m_body / (m_body + n.m);
+        } else if (n.m <= 0.0 || shape_sdf(body.shape, q) >= 0.0) {
           continue;
         }
-        if constexpr (Fraction)
-          if (!touched_[b][k]) continue;
         Vec2 normal = shape_normal(body.shape, q, 1e-4 * dx);
         if constexpr (Fraction) {
           auto m = [&](int a, int c) { return g_.node[g_.index(std::clamp(a, lo, hi_i), std::clamp(c, lo, hi_j))].m; };
@@ -462,7 +499,7 @@ void Simulation::contact_nodes() {
         Vec2 v(n.vx, n.vy);
         const Vec2 before = v;
         if (!contact(v, s.velocity_m_s, normal, mu)) continue;
-        if constexpr (Fraction) v = before + std::min(1.0, kFractionReach - d / dx) * (v - before);
+        if constexpr (Fraction) v = before + share * (v - before);
         impulse += n.m * (v - before);
         n.vx = v.x();
         n.vy = v.y();
@@ -472,14 +509,15 @@ void Simulation::contact_nodes() {
 }
 
 // Cell-fraction contact acts only at nodes a material point has touched: a point whose surface is
-// within kTouchCells of the body marks the nodes of its stencil, and a node stays marked while it
-// holds mass within the ramp's reach. Without this, nodes inside a body act on material up to 1.5
-// cells away (their B-spline support) and the body feels the bed before it meets it.
+// within kTouchCells of the body marks the nodes of its stencil, and a node stays marked while both
+// the media and the body's field reach it. Without this, the body's field acts on material up to
+// a cell from the surface and the body feels the bed before it meets it.
 template <class K>
 void Simulation::contact_cell_fraction() {
   const double dx = g_.dx, inv_dx = 1.0 / dx, reach = 2.0 * dx;
   const int strips = int(strip_start_.size()) - 1;
   touched_.resize(bodies_.size());
+  body_node_mass_kg_.resize(bodies_.size());
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const BodyState& s = bodies_[b];
     const Shape& shape = scene_.bodies[b].shape;
@@ -498,6 +536,19 @@ void Simulation::contact_cell_fraction() {
       const int by = K::weights(p_.y[p] * inv_dx, w, dw, inv_dx);
       for (int j = std::max(by, j0); j <= std::min(by + K::N - 1, j1); ++j)
         for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i) touched[g_.index(i, j)] = 1;
+    }
+    // the body's field over its node box
+    const size_t width = size_t(i1 - i0 + 1);
+    auto& field = body_node_mass_kg_[b];
+    field.assign(width * size_t(j1 - j0 + 1), 0.0);
+    for (const Vec2& q : body_samples_m_[b]) {
+      const Vec2 x = s.position_m + q;
+      double wx[K::N], wy[K::N], dw[K::N];
+      const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
+      const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
+      for (int j = std::max(by, j0); j <= std::min(by + K::N - 1, j1); ++j)
+        for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i)
+          field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
     }
   }
   contact_nodes<true>();

@@ -127,6 +127,7 @@ class Simulation {
 
  private:
   void seed_beds();
+  void sample_body_fields();
   void clear_grid();
   void sort_particles();
   template <class Kernel, bool Flip> void particles_to_grid();
@@ -176,7 +177,12 @@ class Simulation {
   bool fuse_particle_passes_ = true;
   void (Simulation::*contact_)() = nullptr;
   std::vector<ContactPoint> contacts_;
-  std::vector<std::vector<uint8_t>> touched_;  // cell-fraction contact: per body, per node
+  // cell-fraction contact: per body, the nodes a point has touched; its field's sample points
+  // (body frame, m) and their mass (kg per metre); the field's nodal mass over the body's node box
+  std::vector<std::vector<uint8_t>> touched_;
+  std::vector<std::vector<Vec2>> body_samples_m_;
+  double body_sample_mass_kg_ = 0.0;
+  std::vector<std::vector<double>> body_node_mass_kg_;
   std::vector<std::vector<uint32_t>> contact_chunks_;
   std::unique_ptr<tbb::task_arena> arena_;
 };

@@ -22,9 +22,11 @@ struct Trace {
 };
 
 // Runs a template until its lead body has travelled `travel_m` (the template's own end if <= 0).
-Trace run_template(const std::string& name, double travel_m, ContactMethod contact) {
+// `shift_cells` moves the bodies sideways by that fraction of a cell (off the node lines).
+Trace run_template(const std::string& name, double travel_m, ContactMethod contact, double shift_cells = 0.0) {
   Scene s = load_scene((std::filesystem::path(FURROW_SOURCE_DIR) / "scenes" / (name + ".json")).string());
   s.solver.contact = contact;
+  for (auto& b : s.bodies) b.start_m.x() += shift_cells * s.domain.dx_m;
   if (travel_m > 0.0) s.solver.end_displacement_m = travel_m;
   s.outputs.fields.clear();
   Simulation sim(s);
@@ -46,10 +48,12 @@ void report(const char* what, const ForceSmoothness& f) {
 }
 
 // plate_intrusion at its preview dx over its averaging window (45..85 mm of travel)
-ForceSmoothness plate_intrusion_smoothness(ContactMethod contact) {
-  const Trace t = run_template("plate_intrusion", 0.0855, contact);
+ForceSmoothness plate_intrusion_smoothness(ContactMethod contact, double shift_cells = 0.0) {
+  const Trace t = run_template("plate_intrusion", 0.0855, contact, shift_cells);
   const ForceSmoothness f = force_smoothness(t.travel_m, t.drag_N_per_m, t.dx_m, 0.045, 0.085);
-  report((std::string("plate_intrusion, ") + contact_method_name(contact)).c_str(), f);
+  char what[96];
+  std::snprintf(what, sizeof what, "plate_intrusion, %s, shifted %.2f cell", contact_method_name(contact), shift_cells);
+  report(what, f);
   return f;
 }
 
@@ -87,15 +91,19 @@ TEST(ContactSmoothness, LooseIntrusionHasNoSpikes) {
   EXPECT_LE(f.cell_amplitude_relative, 0.02);
 }
 
-// Cell-fraction contact on the same two templates. plate_intrusion: 1.12x, RMS 2.4%, cell
-// component 2.05% (node 1.46x, 8.9%, 7.8%), so the cell bound here is 2.5% where the issue asks 2%;
-// what is left in the RMS has the bed's elastic periods, as with particle contact.
-// loose_intrusion: 1.07x from three cells of penetration (node 4.8x).
+// Cell-fraction contact on the same two templates. plate_intrusion (its plate's sides lie on node
+// lines): 1.13x, RMS 2.0%, cell component 1.8% (node 1.46x, 8.9%, 7.8%); the same plate half a
+// cell off the node lines: 1.08x, 2.15%, 2.0%. The ramp this method used before the body field
+// met the first case (1.12x, 2.4%, 2.05%) but not the second (1.09x, 5.3%, 5.9%), which is why the
+// test runs both. What is left in the RMS has the bed's elastic periods, as with particle contact.
+// loose_intrusion: 1.06x from three cells of penetration (node 4.8x).
 TEST(ContactSmoothness, CellFractionPlateIntrusionHasNoCellComb) {
-  const ForceSmoothness f = plate_intrusion_smoothness(ContactMethod::CellFraction);
-  EXPECT_LE(f.peak_ratio, 1.15);
-  EXPECT_LE(f.cell_amplitude_relative, 0.025);
-  EXPECT_LE(f.rms_relative, 0.03);
+  for (double shift_cells : {0.0, 0.5}) {
+    const ForceSmoothness f = plate_intrusion_smoothness(ContactMethod::CellFraction, shift_cells);
+    EXPECT_LE(f.peak_ratio, 1.15) << "shifted " << shift_cells << " cell";
+    EXPECT_LE(f.cell_amplitude_relative, 0.025) << "shifted " << shift_cells << " cell";
+    EXPECT_LE(f.rms_relative, 0.03) << "shifted " << shift_cells << " cell";
+  }
 }
 
 TEST(ContactSmoothness, CellFractionLooseIntrusionHasNoSpikes) {
