@@ -117,10 +117,18 @@ std::string scene_summary(const Scene& s, const std::string& source) {
   for (const auto& m : s.materials)
     os << "  material   " << m.name << ": " << (m.model == MaterialModel::DPM ? "DPM" : "NDPM")
        << ", wave speed " << fmt("%.3g", wave_speed_m_s(m)) << " m/s\n";
-  for (const auto& b : s.bodies)
-    os << "  body       " << b.name << ": " << kShapeNames[int(b.shape.kind)] << ", max speed "
-       << fmt("%g", motion_max_speed_m_s(b.motion)) << " m/s, "
-       << contact_method_name(s.solver.contact) << " contact\n";
+  for (const auto& b : s.bodies) {
+    const double cells = body_cells_across(s, b), bias = contact_size_bias(s.solver.contact, cells);
+    os << "  body       " << b.name << ": " << kShapeNames[int(b.shape.kind)] << ", " << fmt("%.3g", cells)
+       << " cells across its travel, max speed " << fmt("%g", motion_max_speed_m_s(b.motion)) << " m/s, "
+       << contact_method_name(s.solver.contact) << " contact";
+    if (cells < 8.0)
+      os << " (under 8 cells across: its force depends strongly on dx and the contact method)";
+    else if (std::abs(bias) >= 0.01)
+      os << " (a plate this many cells across reads ~" << fmt("%.0f", 100 * std::abs(bias)) << "% "
+         << (bias < 0 ? "low" : "high") << ": README \"Body contact\")";
+    os << "\n";
+  }
   os << "  time step  ~" << fmt("%.3g", dt) << " s (cfl " << fmt("%g", s.solver.cfl) << ")\n";
   os << "  end        t = " << fmt("%.4g", t_end) << " s";
   const int ref = reference_body_index(s);
@@ -180,8 +188,10 @@ Command command_validate() {
           "Reads SCENE.json, applies the --set overrides and checks every key: unknown or misspelt keys,\n"
           "types, units and physical ranges, bodies and beds inside the domain, and the estimated cost.\n"
           "On success prints the resolved scene (every default filled in) as JSON on standard output and\n"
-          "a summary (grid, particles, time step, steps, frames) on standard error, and exits 0. On error\n"
-          "prints FILE: /json/pointer: got VALUE, expected ... and exits 1.\n\n" +
+          "a summary (grid, particles, bodies with their size in cells across their travel and how far\n"
+          "a plate that size reads from its converged force, time step, steps, wall time, frames) on\n"
+          "standard error, and exits 0. On error prints FILE: /json/pointer: got VALUE, expected ... and\n"
+          "exits 1.\n\n" +
               std::string(kSetHelp),
           {{"--set", true, true, "override a scene value", "key.path=value"},
            {"--yes", false, false, "accept scenes estimated above 2e7 particles or 2e6 steps"},

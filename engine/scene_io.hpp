@@ -83,6 +83,13 @@ size_t estimate_particle_count(const Scene& scene);
 double estimate_end_time_s(const Scene& scene);
 // ceil(estimate_end_time_s / estimate_time_step_s).
 int64_t estimate_step_count(const Scene& scene);
+// A body's extent across its direction of travel (halfway through the run), in cells; its
+// smallest extent if it does not move.
+double body_cells_across(const Scene& scene, const Body& body);
+// How far a body's mean force at `cells_across` tends to sit from its converged value with each
+// contact method (relative, + = larger): ~ c / cells, c fitted to a plate at 8, 16 and 32 cells
+// (README, "Body contact"): node acts smaller, cell_fraction and particle larger.
+double contact_size_bias(ContactMethod method, double cells_across);
 
 // ---- body kinematics (prescribed motion) ----
 Vec2 motion_velocity_m_s(const Motion& motion, double t_s);

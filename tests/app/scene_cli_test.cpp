@@ -151,3 +151,23 @@ TEST_F(SceneCli, ValidateSetsAndYes) {
   EXPECT_TRUE(r.out.empty());  // --brief: summary only
   EXPECT_NE(r.err.find("72000000"), std::string::npos) << r.err;
 }
+
+// validate says how many cells a body spans across its travel, and how far a plate that size
+// reads from its converged force: plate_intrusion's 0.1 m plate descends, so its width counts
+// (0.1 m / dx); turned to move sideways its 0.02 m thickness counts.
+TEST_F(SceneCli, ValidateGivesCellsAcrossTheTravelAndTheContactBias) {
+  const std::string file = path("p.json");
+  ASSERT_EQ(run({"new", "plate_intrusion", "-o", file}).status, 0);
+  Result r = run({"validate", file, "--brief"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("plate: box, 10 cells across its travel"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("node contact (a plate this many cells across reads ~11% low"), std::string::npos) << r.err;
+  r = run({"validate", file, "--brief", "--set", "domain.dx_m=0.0025", "--set", "solver.contact=cell_fraction"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("40 cells across its travel"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("reads ~3% high"), std::string::npos) << r.err;
+  r = run({"validate", file, "--brief", "--set", "bodies.plate.motion.velocity_m_s=[0.1,0.0]"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("2 cells across its travel"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("under 8 cells across"), std::string::npos) << r.err;
+}
