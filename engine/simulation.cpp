@@ -128,9 +128,9 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   };
   if (scene_.effects.rate_dependence) pick_law(std::true_type{});
   else pick_law(std::false_type{});
-  if (!track_plastic_) {
-    p_.plastic_strain = {};
-    p_.strain_rate = {};
+  if (!track_plastic_) {  // freed, not only emptied (`= {}` kept their storage)
+    std::vector<double>().swap(p_.plastic_strain);
+    std::vector<rate_t>().swap(p_.strain_rate);
   }
   const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
   arena_ = std::make_unique<tbb::task_arena>(threads);
