@@ -29,7 +29,11 @@ int main(int argc, char** argv) {
     return args.empty() ? 2 : 0;
   }
   if (args[0] == "--version") {
-    std::cout << "furrow " << FURROW_VERSION << "\nMPI: " << cli::mpi::build_text() << "\n";
+    std::cout << "furrow " << FURROW_VERSION << "\nMPI: " << cli::mpi::build_text()
+              << "\nparticle state: "
+              << (FURROW_DOUBLE_STATE ? "double (FURROW_DOUBLE_STATE=ON)"
+                                      : "float stress, pressure, mass, affine matrix, strain rate (FURROW_DOUBLE_STATE=OFF)")
+              << "\n";
     return 0;
   }
   const cli::Command* cmd = nullptr;

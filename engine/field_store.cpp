@@ -26,7 +26,7 @@ namespace {
 // from. velocity, packing_fraction and density have their own rules in rasterize().
 struct AveragedField {
   const char* name;
-  const double* ParticleView::*array;
+  ScalarArray ParticleView::*array;
 };
 const AveragedField kAveraged[] = {
     {"pressure", &ParticleView::pressure_Pa},
@@ -42,7 +42,7 @@ std::string known_field_names() {
   return s;
 }
 
-void require_array(const double* a, const std::string& field, const char* array) {
+void require_array(const ScalarArray& a, const std::string& field, const char* array) {
   if (!a)
     throw std::invalid_argument("rasterize: field '" + field + "' requested but the particle array '" +
                                 array + "' is not provided");
@@ -65,7 +65,7 @@ FieldFrame rasterize(const ParticleView& p, const RasterSpec& spec,
 
   // resolve the request against the registry
   bool want_velocity = false, want_packing = false, want_density = false;
-  std::vector<std::pair<std::string, const double*>> averaged;
+  std::vector<std::pair<std::string, ScalarArray>> averaged;
   for (const auto& name : fields) {
     if (!find_field(name))
       throw std::invalid_argument("rasterize: unknown field '" + name + "' (known: " +

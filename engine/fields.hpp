@@ -2,6 +2,7 @@
 // from the solver to the field store and from the store to the renderer.
 #pragma once
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -22,21 +23,37 @@ struct FieldInfo {
 const std::vector<FieldInfo>& field_registry();
 const FieldInfo* find_field(const std::string& name);
 
-// Read-only view of particle arrays (structure of arrays) for rasterization. Null pointers mean
+// A read-only particle array stored as double or float (the solver stores some quantities as
+// float: README, Performance); reads give double.
+class ScalarArray {
+ public:
+  ScalarArray() = default;
+  ScalarArray(std::nullptr_t) {}
+  ScalarArray(const double* a) : f64_(a) {}
+  ScalarArray(const float* a) : f32_(a) {}
+  double operator[](size_t i) const { return f64_ ? f64_[i] : double(f32_[i]); }
+  explicit operator bool() const { return f64_ || f32_; }
+
+ private:
+  const double* f64_ = nullptr;
+  const float* f32_ = nullptr;
+};
+
+// Read-only view of particle arrays (structure of arrays) for rasterization. Null arrays mean
 // "not computed for this run" and the corresponding fields are skipped.
 struct ParticleView {
   size_t count = 0;
   const double* x_m = nullptr;
   const double* y_m = nullptr;
-  const double* mass_kg = nullptr;        // per metre out of plane
-  const double* volume_m2 = nullptr;      // current area (per metre out of plane)
-  const double* vx_m_s = nullptr;
-  const double* vy_m_s = nullptr;
-  const double* pressure_Pa = nullptr;
-  const double* strain_rate_1_s = nullptr;   // equivalent plastic shear rate
-  const double* plastic_strain = nullptr;    // equivalent plastic shear strain
-  const double* phi_d = nullptr;             // DPM state
-  const double* grain_density_kg_m3 = nullptr;  // per particle rho_g (packing = m / (rho_g V))
+  ScalarArray mass_kg;                    // per metre out of plane
+  ScalarArray volume_m2;                  // current area (per metre out of plane)
+  ScalarArray vx_m_s;
+  ScalarArray vy_m_s;
+  ScalarArray pressure_Pa;
+  ScalarArray strain_rate_1_s;            // equivalent plastic shear rate
+  ScalarArray plastic_strain;             // equivalent plastic shear strain
+  ScalarArray phi_d;                      // DPM state
+  ScalarArray grain_density_kg_m3;        // per particle rho_g (packing = m / (rho_g V))
 };
 
 // A body as drawn in a frame: its outline polygon in world coordinates and the force it feels.

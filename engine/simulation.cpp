@@ -13,6 +13,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <tuple>
+#include <type_traits>
 
 #include "engine/bodies.hpp"
 #include "engine/scene_io.hpp"
@@ -133,9 +134,9 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   };
   if (scene_.effects.rate_dependence) pick_law(std::true_type{});
   else pick_law(std::false_type{});
-  if (!track_plastic_) {
-    p_.plastic_strain = {};
-    p_.strain_rate = {};
+  if (!track_plastic_) {  // freed, not only emptied (`= {}` kept their storage)
+    std::vector<double>().swap(p_.plastic_strain);
+    std::vector<rate_t>().swap(p_.strain_rate);
   }
   const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
   arena_ = std::make_unique<tbb::task_arena>(threads);
@@ -156,7 +157,9 @@ void Simulation::seed_beds() {
     const double phi_i = bed.packing_fraction;
     const double phi_d = dilatancy_ && mat->model == MaterialModel::DPM ? phi_i : mp.phi_c;
     const double k0 = bed.k0 >= 0.0 ? bed.k0 : 1.0 - std::sin(std::atan(mp.friction(phi_d)));
-    const double mass = mp.rho_g * phi_i * v0;
+    // rounded to its stored precision first: the volume below is derived from the stored value, so
+    // phi = m / (rho_g V) is the seeded packing to double round-off in either precision
+    const double mass = mass_t(mp.rho_g * phi_i * v0);
     const long kx0 = long(std::floor(bed.min_m.x() / h)), kx1 = long(std::ceil(bed.max_m.x() / h));
     const long ky0 = long(std::floor(bed.min_m.y() / h)), ky1 = long(std::ceil(bed.max_m.y() / h));
     for (long ky = ky0; ky <= ky1; ++ky) {
@@ -191,7 +194,12 @@ void Simulation::seed_beds() {
     }
   }
   const size_t n = p_.x.size();
-  for (auto* a : {&p_.c00, &p_.c01, &p_.c10, &p_.c11, &p_.plastic_strain, &p_.strain_rate}) a->assign(n, 0.0);
+  for (auto* a : {&p_.c00, &p_.c01, &p_.c10, &p_.c11}) a->assign(n, 0.0);
+  p_.plastic_strain.assign(n, 0.0);
+  p_.strain_rate.assign(n, 0.0);
+  // push_back left up to twice the points' storage (12% at 1.84M points); the reorder's swaps
+  // would carry that slack along for the whole run
+  p_.for_each_array([](auto& a) { a.shrink_to_fit(); });
 }
 
 double Simulation::next_dt_s() const {
@@ -298,15 +306,12 @@ void Simulation::sort_particles() {
   const int strips = g_.nx / kStripCells + 3;
   constexpr size_t kChunks = 64;
   const size_t chunk = (n + kChunks - 1) / kChunks;
-  scratch_u32_.resize(n);
   chunk_counts_.assign(kChunks * size_t(strips), 0);  // [chunk][strip]
   const double inv = 1.0 / g_.dx;
   tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
     uint32_t* count = &chunk_counts_[c * size_t(strips)];
     for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) {
-      const int s = strip_index(p_.x[i], inv, kStripCells, strips);
-      scratch_u32_[i] = uint32_t(s);
-      ++count[s];
+      ++count[strip_index(p_.x[i], inv, kStripCells, strips)];
     }
   });
   // exclusive prefix over (strip, chunk): each chunk's first slot within each strip
@@ -326,7 +331,7 @@ void Simulation::sort_particles() {
   tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
     uint32_t* fill = &chunk_counts_[c * size_t(strips)];
     for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i)
-      order_[fill[scratch_u32_[i]]++] = uint32_t(i);
+      order_[fill[strip_index(p_.x[i], inv, kStripCells, strips)]++] = uint32_t(i);
   });
 }
 
@@ -344,7 +349,8 @@ void Simulation::particles_to_grid() {
       const int bx = K::weights(xp * inv_dx, wx, dwx, inv_dx);
       const int by = K::weights(yp * inv_dx, wy, dwy, inv_dx);
       const double m = P.mass[p], V = P.volume[p];
-      const double sxx = P.sxx[p] - P.pressure[p], syy = P.syy[p] - P.pressure[p], sxy = P.sxy[p];
+      const double pressure = P.pressure[p];
+      const double sxx = P.sxx[p] - pressure, syy = P.syy[p] - pressure, sxy = P.sxy[p];
       const double mvx = m * P.vx[p], mvy = m * P.vy[p];
       // momentum affine Q = m C; MLS force affine S = -dt V D^-1 sigma (grad w ~ w D^-1 (x_i - x_p)).
       // Without FLIP both act on the same momentum and fold into one matrix.
@@ -785,11 +791,11 @@ void Simulation::front_back_friction() {
       tbb::blocked_range<size_t>(0, P.size(), kGrain), Vec2(0.0, 0.0),
       [&](const tbb::blocked_range<size_t>& r, Vec2 sum) {
         for (size_t p = r.begin(); p < r.end(); ++p) {
-          const double sigma_zz = P.szz[p] - P.pressure[p];
+          const double sigma_zz = double(P.szz[p]) - P.pressure[p];
           const double speed = std::hypot(P.vx[p], P.vy[p]);
           if (sigma_zz >= 0.0 || speed == 0.0) continue;
           const double keep = 1.0 - std::min(speed, k * -sigma_zz * P.volume[p] / P.mass[p]) / speed;
-          sum -= P.mass[p] * (1.0 - keep) * Vec2(P.vx[p], P.vy[p]);
+          sum -= double(P.mass[p]) * (1.0 - keep) * Vec2(P.vx[p], P.vy[p]);
           P.vx[p] *= keep;
           P.vy[p] *= keep;
         }
@@ -879,7 +885,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
       x -= d * n;
       const Vec2 v0 = v;
       contact(v, s.velocity_m_s, n, 0.0);
-      loc.impulse[b] += P.mass[p] * (v - v0);
+      loc.impulse[b] += double(P.mass[p]) * (v - v0);
       ++loc.projected;
     }
     // the grid margin bounds where a particle may go; walls normally stop it well before
@@ -978,35 +984,33 @@ void Simulation::reorder_particles() {
       return a.particle != b.particle ? a.particle < b.particle : a.body < b.body;
     });
   }
-  // One gather buffer for all arrays: each array swaps its storage into it and the old storage
+  // One gather buffer per element type: each array swaps its storage into it and the old storage
   // takes the next array. A fresh buffer per array page-faulted ~15 MB each at 1.84M points.
-  std::vector<std::vector<double>*> arrays = {&p_.x, &p_.y, &p_.vx, &p_.vy, &p_.c00, &p_.c01, &p_.c10,
-                                              &p_.c11, &p_.mass, &p_.volume, &p_.sxx, &p_.syy, &p_.sxy,
-                                              &p_.szz, &p_.pressure, &p_.phi_d, &p_.plastic_strain,
-                                              &p_.strain_rate};
-  std::vector<double> buffer(n);
+  std::vector<double> buffer_f64;
+  std::vector<float> buffer_f32;
+  std::vector<uint8_t> buffer_u8;
   const tbb::blocked_range<size_t> all(0, n, size_t(1) << 14);
-  for (auto* a : arrays) {
-    if (a->empty()) continue;
+  p_.for_each_array([&](auto& a) {
+    using T = typename std::decay_t<decltype(a)>::value_type;
+    if (a.empty()) return;
+    auto& buffer = [&]() -> std::vector<T>& {
+      if constexpr (std::is_same_v<T, double>) return buffer_f64;
+      else if constexpr (std::is_same_v<T, float>) return buffer_f32;
+      else return buffer_u8;
+    }();
+    buffer.resize(n);
     tbb::parallel_for(all, [&](const auto& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) buffer[i] = (*a)[perm[i]];
+      for (size_t i = r.begin(); i < r.end(); ++i) buffer[i] = a[perm[i]];
     });
-    a->swap(buffer);
-  }
-  std::vector<uint8_t> material(n);
-  for (size_t i = 0; i < n; ++i) material[i] = p_.material[perm[i]];
-  p_.material.swap(material);
+    a.swap(buffer);
+  });
 }
 
 size_t Simulation::state_bytes() const {
   size_t b = 0;
-  for (const auto* a : {&p_.x, &p_.y, &p_.vx, &p_.vy, &p_.c00, &p_.c01, &p_.c10, &p_.c11, &p_.mass, &p_.volume,
-                        &p_.sxx, &p_.syy, &p_.sxy, &p_.szz, &p_.pressure, &p_.phi_d, &p_.plastic_strain,
-                        &p_.strain_rate})
-    b += a->capacity() * sizeof(double);
-  b += p_.material.capacity() + g_.node.capacity() * sizeof(GridNode);
-  b += (order_.capacity() + strip_start_.capacity() + scratch_u32_.capacity() + chunk_counts_.capacity()) *
-       sizeof(uint32_t);
+  p_.for_each_array([&](const auto& a) { b += a.capacity() * sizeof(a[0]); });
+  b += g_.node.capacity() * sizeof(GridNode);
+  b += (order_.capacity() + strip_start_.capacity() + chunk_counts_.capacity()) * sizeof(uint32_t);
   return b;
 }
 
@@ -1014,7 +1018,7 @@ double Simulation::total_mass() const { return std::accumulate(p_.mass.begin(), 
 
 Vec2 Simulation::total_momentum() const {
   Vec2 m(0, 0);
-  for (size_t p = 0; p < p_.size(); ++p) m += p_.mass[p] * Vec2(p_.vx[p], p_.vy[p]);
+  for (size_t p = 0; p < p_.size(); ++p) m += double(p_.mass[p]) * Vec2(p_.vx[p], p_.vy[p]);
   return m;
 }
 

@@ -16,16 +16,52 @@
 
 namespace furrow {
 
+// Stored precision of each class of particle quantity (measured in README, Performance). The
+// arithmetic is double throughout: a value is loaded into a double, updated, and rounded once when
+// stored. float (4 B instead of 8) where a stored value's rounding cannot accumulate; the CMake
+// option FURROW_DOUBLE_STATE stores everything as double (same bits as before the split).
+#if FURROW_DOUBLE_STATE
+using reduced_t = double;
+#else
+using reduced_t = float;
+#endif
+using mass_t = reduced_t;      // constant per point: rounded once at seeding, the volume derived from it
+using affine_t = reduced_t;    // rebuilt from the grid by every G2P, never accumulated
+using stress_t = reduced_t;    // deviatoric: hypoelastic increments of ~1e-5 of it per step, with
+                               // rounding of ~6e-8 of it (a random walk); the return clamps it to mu P
+using pressure_t = reduced_t;  // recomputed from the volume every step, P = K ln(phi / phi_d)
+using rate_t = reduced_t;      // plastic strain rate: an output, recomputed every step
+// Kept double: positions and velocities (integrated every step; the media's momentum balances the
+// bodies' forces to double round-off), volume (integrated every step, and the pressure is K times
+// its log strain: elastic strains are ~1e-3, so float's 6e-8 would be percent-level errors at
+// shallow depth), phi_d and plastic strain (integrated every step).
+
 struct Particles {
   std::vector<double> x, y, vx, vy;            // position (m), velocity (m/s)
-  std::vector<double> c00, c01, c10, c11;      // affine velocity field = velocity gradient (1/s)
-  std::vector<double> mass, volume;            // kg and m^2 per metre out of plane
-  std::vector<double> sxx, syy, sxy, szz;      // deviatoric stress (Pa)
-  std::vector<double> pressure;                // Pa
+  std::vector<affine_t> c00, c01, c10, c11;    // affine velocity field = velocity gradient (1/s)
+  std::vector<mass_t> mass;                    // kg per metre out of plane
+  std::vector<double> volume;                  // m^2 per metre out of plane
+  std::vector<stress_t> sxx, syy, sxy, szz;    // deviatoric stress (Pa)
+  std::vector<pressure_t> pressure;            // Pa
   std::vector<double> phi_d;                   // DPM dense-state packing; empty without dilatancy
-  std::vector<double> plastic_strain, strain_rate;  // only when an output field needs them
+  std::vector<double> plastic_strain;          // only when an output field needs it
+  std::vector<rate_t> strain_rate;             // (1/s) only when an output field needs it
   std::vector<uint8_t> material;               // index into Scene::materials
   size_t size() const { return x.size(); }
+  // Calls f on every per-point array (for what treats them alike: the reorder, the byte count).
+  template <class F> void for_each_array(F&& f) { each(*this, f); }
+  template <class F> void for_each_array(F&& f) const { each(*this, f); }
+
+ private:
+  template <class Self, class F> static void each(Self& p, F& f) {
+    for (auto* a : {&p.x, &p.y, &p.vx, &p.vy, &p.volume, &p.phi_d, &p.plastic_strain}) f(*a);
+    for (auto* a : {&p.c00, &p.c01, &p.c10, &p.c11}) f(*a);
+    f(p.mass);
+    for (auto* a : {&p.sxx, &p.syy, &p.sxy, &p.szz}) f(*a);
+    f(p.pressure);
+    f(p.strain_rate);
+    f(p.material);
+  }
 };
 
 // One grid node, interleaved so a particle's 3x3 stencil touches few cache lines.
@@ -169,7 +205,7 @@ class Simulation {
   // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
   static constexpr int kStripCells = 4;
   std::vector<uint32_t> order_, strip_start_;
-  std::vector<uint32_t> scratch_u32_, chunk_counts_;
+  std::vector<uint32_t> chunk_counts_;
   mutable std::vector<double> rho_g_cache_;
   void (Simulation::*p2g_)() = nullptr;
   void (Simulation::*g2p_range_)(size_t, size_t, G2PLocal&) = nullptr;

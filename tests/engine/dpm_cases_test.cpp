@@ -70,9 +70,9 @@ TEST(DpmLimit, ZeroChiEqualsNdpmInAWholeRun) {
   double pmax = 0.0, worst_stress = 0.0, worst_x = 0.0;
   int plastic = 0, open = 0;
   for (size_t i = 0; i < pa.size(); ++i) {
-    pmax = std::max(pmax, pa.pressure[i]);
+    pmax = std::max(pmax, double(pa.pressure[i]));
     for (auto m : {&Particles::pressure, &Particles::sxx, &Particles::syy, &Particles::sxy, &Particles::szz})
-      worst_stress = std::max(worst_stress, std::abs((pa.*m)[i] - (pb.*m)[i]));
+      worst_stress = std::max(worst_stress, std::abs(double((pa.*m)[i]) - (pb.*m)[i]));
     worst_x = std::max({worst_x, std::abs(pa.x[i] - pb.x[i]), std::abs(pa.y[i] - pb.y[i])});
     plastic += pa.plastic_strain[i] > 0.0;
     open += pa.pressure[i] == 0.0;

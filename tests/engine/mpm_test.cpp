@@ -83,7 +83,7 @@ TEST(Mpm, RigidTranslationLeavesStressUnchanged) {
   const auto& q = sim.particles();
   double smax = 0.0, dvol = 0.0, dx_err = 0.0;
   for (size_t i = 0; i < q.size(); ++i) {
-    smax = std::max({smax, std::abs(q.sxx[i]), std::abs(q.sxy[i]), std::abs(q.pressure[i])});
+    smax = std::max({smax, std::abs(double(q.sxx[i])), std::abs(double(q.sxy[i])), std::abs(double(q.pressure[i]))});
     dvol = std::max(dvol, std::abs(q.volume[i] / vol0[i] - 1.0));
   }
   // particles were reordered in memory: compare the mean displacement instead of per index
