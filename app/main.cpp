@@ -31,8 +31,8 @@ int main(int argc, char** argv) {
   if (args[0] == "--version") {
     std::cout << "furrow " << FURROW_VERSION << "\nMPI: " << cli::mpi::build_text()
               << "\nparticle state: "
-              << (FURROW_DOUBLE_STATE ? "double (FURROW_DOUBLE_STATE=ON)"
-                                      : "float stress, pressure, mass, affine matrix, strain rate (FURROW_DOUBLE_STATE=OFF)")
+              << (FURROW_FLOAT_STATE ? "float stress, pressure, mass, affine matrix, strain rate (FURROW_FLOAT_STATE=ON)"
+                                     : "double (FURROW_FLOAT_STATE=OFF)")
               << "\n";
     return 0;
   }

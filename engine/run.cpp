@@ -263,7 +263,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
                         {"g2p", ph.g2p}, {"constitutive", ph.constitutive},
                         {"g2p_constitutive", ph.g2p_constitutive}, {"reorder", ph.reorder}};
   j["state_bytes_per_particle"] = sim.particles().size() ? double(sim.state_bytes()) / sim.particles().size() : 0.0;
-  j["state_precision"] = FURROW_DOUBLE_STATE ? "double" : "float stress, pressure, mass, affine matrix, strain rate";
+  j["state_precision"] = FURROW_FLOAT_STATE ? "float stress, pressure, mass, affine matrix, strain rate" : "double";
   j["frames"] = frame_index;
   j["lead_body_travel_m"] = sim.lead_body_travel_m();
   j["units"] = {{"force", "N/m (per metre out of plane)"}, {"time", "s"}, {"length", "m"}};
