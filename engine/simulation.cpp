@@ -199,7 +199,7 @@ void Simulation::seed_beds() {
   p_.strain_rate.assign(n, 0.0);
   // push_back left up to twice the points' storage (12% at 1.84M points); the reorder's swaps
   // would carry that slack along for the whole run
-  p_.for_each_array([](auto& a) { a.shrink_to_fit(); });
+  p_.for_each_array([](const char*, auto& a) { a.shrink_to_fit(); });
 }
 
 double Simulation::next_dt_s() const {
@@ -990,7 +990,7 @@ void Simulation::reorder_particles() {
   std::vector<float> buffer_f32;
   std::vector<uint8_t> buffer_u8;
   const tbb::blocked_range<size_t> all(0, n, size_t(1) << 14);
-  p_.for_each_array([&](auto& a) {
+  p_.for_each_array([&](const char*, auto& a) {
     using T = typename std::decay_t<decltype(a)>::value_type;
     if (a.empty()) return;
     auto& buffer = [&]() -> std::vector<T>& {
@@ -1008,7 +1008,7 @@ void Simulation::reorder_particles() {
 
 size_t Simulation::state_bytes() const {
   size_t b = 0;
-  p_.for_each_array([&](const auto& a) { b += a.capacity() * sizeof(a[0]); });
+  p_.for_each_array([&](const char*, const auto& a) { b += a.capacity() * sizeof(a[0]); });
   b += g_.node.capacity() * sizeof(GridNode);
   b += (order_.capacity() + strip_start_.capacity() + chunk_counts_.capacity()) * sizeof(uint32_t);
   return b;

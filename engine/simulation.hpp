@@ -49,19 +49,19 @@ struct Particles {
   std::vector<rate_t> strain_rate;             // (1/s) only when an output field needs it
   std::vector<uint8_t> material;               // index into Scene::materials
   size_t size() const { return x.size(); }
-  // Calls f on every per-point array (for what treats them alike: the reorder, the byte count).
+  // Calls f(name, array) on every per-point array: the one list of them, for what treats them
+  // alike (the reorder, the byte count, the stability suite's finiteness check).
   template <class F> void for_each_array(F&& f) { each(*this, f); }
   template <class F> void for_each_array(F&& f) const { each(*this, f); }
 
  private:
   template <class Self, class F> static void each(Self& p, F& f) {
-    for (auto* a : {&p.x, &p.y, &p.vx, &p.vy, &p.volume, &p.phi_d, &p.plastic_strain}) f(*a);
-    for (auto* a : {&p.c00, &p.c01, &p.c10, &p.c11}) f(*a);
-    f(p.mass);
-    for (auto* a : {&p.sxx, &p.syy, &p.sxy, &p.szz}) f(*a);
-    f(p.pressure);
-    f(p.strain_rate);
-    f(p.material);
+    f("x", p.x), f("y", p.y), f("vx", p.vx), f("vy", p.vy);
+    f("c00", p.c00), f("c01", p.c01), f("c10", p.c10), f("c11", p.c11);
+    f("mass", p.mass), f("volume", p.volume);
+    f("sxx", p.sxx), f("syy", p.syy), f("sxy", p.sxy), f("szz", p.szz), f("pressure", p.pressure);
+    f("phi_d", p.phi_d), f("plastic_strain", p.plastic_strain), f("strain_rate", p.strain_rate);
+    f("material", p.material);
   }
 };
 

@@ -177,19 +177,14 @@ class Checker {
     const long double m = mass_sum(p);
     if (std::abs(m - m0_) > 2.0L * (long double)n0_ * std::numeric_limits<long double>::epsilon() * m0_)
       return fail(sim) << "mass " << double(m) << " != initial " << double(m0_);
-    // arrays of either stored precision (float or double, engine/simulation.hpp)
+    // every per-point array, of either stored precision (float or double, engine/simulation.hpp)
     const char* bad = nullptr;
     size_t bad_i = 0;
     double bad_value = 0.0;
-    auto scan = [&](const char* name, const auto& a) {
+    p.for_each_array([&](const char* name, const auto& a) {
       for (size_t i = 0; i < a.size() && !bad; ++i)
         if (!std::isfinite(double(a[i]))) bad = name, bad_i = i, bad_value = double(a[i]);
-    };
-    scan("x", p.x), scan("y", p.y), scan("vx", p.vx), scan("vy", p.vy);
-    scan("c00", p.c00), scan("c01", p.c01), scan("c10", p.c10), scan("c11", p.c11);
-    scan("sxx", p.sxx), scan("syy", p.syy), scan("sxy", p.sxy), scan("szz", p.szz);
-    scan("pressure", p.pressure), scan("volume", p.volume), scan("phi_d", p.phi_d);
-    scan("plastic_strain", p.plastic_strain), scan("strain_rate", p.strain_rate);
+    });
     if (bad) return fail(sim) << bad << " of particle " << bad_i << " is " << bad_value;
     for (size_t i = 0; i < p.size(); ++i)
       if (!(p.volume[i] > 0.0)) return fail(sim) << "volume of particle " << i << " is " << p.volume[i];
