@@ -1,9 +1,11 @@
 // The shared checker can fail: each of its bounds, fed a state that breaks it by a little, says so.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 
 #include "tests/stability/stability_check.hpp"
 #include "tests/stability/stability_scenes.hpp"
@@ -65,7 +67,14 @@ TEST(Checker, CatchesNonFiniteValues) {
 }
 
 TEST(Checker, CatchesMassChangeAndEscape) {
-  expect_caught(tampered(10, [](Simulation& sim) { sim.mutable_particles().mass[0] *= 1.0 + 1e-10; }), "mass");
+  // one point's mass up by 1e-10, or by one unit in the last place where the stored precision
+  // (float by default, engine/simulation.hpp) cannot hold a change that small
+  expect_caught(tampered(10, [](Simulation& sim) {
+                  auto& m = sim.mutable_particles().mass[0];
+                  using T = std::decay_t<decltype(m)>;
+                  m = std::max(T(double(m) * (1.0 + 1e-10)), std::nextafter(m, T(2) * m));
+                }),
+                "mass");
   expect_caught(tampered(10, [](Simulation& sim) { sim.mutable_particles().x[5] = -0.3 * 0.005; }), "outside");
 }
 
