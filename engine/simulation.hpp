@@ -18,9 +18,9 @@ namespace furrow {
 
 // Stored precision of each class of particle quantity (measured in README, Performance). The
 // arithmetic is double throughout: a value is loaded into a double, updated, and rounded once when
-// stored. The CMake option FURROW_FLOAT_STATE stores as float (4 B instead of 8) the quantities
-// whose stored rounding cannot accumulate; the default keeps double (README, Performance: float
-// runs' force fluctuations are not yet shown to match).
+// stored. The CMake option FURROW_FLOAT_STATE (ON by default) stores as float (4 B instead of 8)
+// the quantities whose stored rounding cannot accumulate; OFF keeps double (README, "Stored
+// precision": perturbed runs of both builds agree within their scatter).
 #if FURROW_FLOAT_STATE
 using reduced_t = float;
 #else
