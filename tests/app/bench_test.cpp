@@ -30,11 +30,6 @@ class BenchCli : public furrow::cli_test::CliFixture {
   void SetUp() override {
     CliFixture::SetUp();
     std::ofstream(path("tiny.json")) << kScene;
-    ::setenv("FURROW_CALIBRATION", path("calibration.json").c_str(), 1);
-  }
-  void TearDown() override {
-    ::unsetenv("FURROW_CALIBRATION");
-    CliFixture::TearDown();
   }
   // validate's particle-step estimate and its "wall time" line
   std::pair<double, std::string> validate() {

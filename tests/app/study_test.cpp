@@ -194,6 +194,26 @@ TEST_F(StudyCli, TableAgreesWithItsRunsAndARerunReusesThem) {
   EXPECT_EQ(t2.rows[1].at("drag_mean_N_per_m"), t.rows[1].at("drag_mean_N_per_m"));  // deterministic
 }
 
+TEST_F(StudyCli, StoredCalibrationPredictsTheFirstRung) {
+  // no finished rung to extrapolate from: the first rung's prediction is its particle-steps over the
+  // calibrated rate (the tiny scene runs quadratic NDPM on one thread)
+  const nlohmann::json c = {
+      {"host", "test"}, {"cpu", "test"}, {"date", "today"}, {"particles", 1000},
+      {"entries",
+       {{{"shape_function", "quadratic"}, {"model", "ndpm"}, {"threads", 1}, {"particle_steps_per_s", 1e5}},
+        {{"shape_function", "linear"}, {"model", "ndpm"}, {"threads", 1}, {"particle_steps_per_s", 1e7}}}}};
+  std::ofstream(path("calibration.json")) << c.dump();
+  const std::string out = path("s");
+  const auto r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005", "--out", out});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Table t = read_csv(fs::path(out) / "study.csv");
+  ASSERT_EQ(t.rows.size(), 2u);
+  ASSERT_FALSE(t.rows[0].at("predicted_wall_s").empty());
+  // validate's particle-step estimate, not the run's count, feeds the prediction: within 10% of it
+  EXPECT_NEAR(std::stod(t.rows[0].at("predicted_wall_s")), std::stod(t.rows[0].at("particle_steps")) / 1e5,
+              0.1 * std::stod(t.rows[0].at("particle_steps")) / 1e5);
+}
+
 TEST_F(StudyCli, StoppedStudyKeepsFinishedRungsAndFinishesOnRerun) {
   const std::string out = path("s");
   const std::string cmd = furrow::cli_test::quote(FURROW_CLI_PATH) + " study " +
