@@ -107,7 +107,7 @@ double predict_run_wall_s(const Calibration& c, const Scene& scene, std::string*
         break;
       }
   }
-  const double psteps = double(estimate_particle_count(scene)) * double(estimate_step_count(scene));
+  const double psteps = estimate_particle_steps(scene);
   if (how) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "%d thread%s, %s %s at %.3g M particle-steps/s", threads, threads == 1 ? "" : "s",

@@ -134,7 +134,9 @@ std::string scene_summary(const Scene& s, const std::string& source) {
   const int ref = reference_body_index(s);
   if (t_end < s.solver.end_time_s && ref >= 0)
     os << " (body \"" << s.bodies[size_t(ref)].name << "\" travels " << fmt("%g", s.solver.end_displacement_m) << " m)";
-  os << "\n  steps      ~" << steps << ", " << fmt("%.3g", double(steps) * double(particles)) << " particle-steps\n";
+  os << "\n  steps      ~" << steps << ", " << fmt("%.3g", estimate_particle_steps(s)) << " particle-steps";
+  if (steps > s.solver.max_steps) os << " (to solver.max_steps)";
+  os << "\n";
   os << "  wall time  " << predicted_wall_text(s) << "\n";
   if (s.outputs.frame_interval_s > 0.0) {
     os << "  frames     " << long(std::floor(t_end / s.outputs.frame_interval_s + 1e-9)) + 1 << " every "

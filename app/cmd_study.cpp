@@ -98,7 +98,7 @@ int study_main(const Parsed& p) {
       if (!is_dx_ladder(ladders[k])) g.group += (g.group.empty() ? "" : ", ") + ladders[k].column + "=" + g.values.back();
     }
     g.dx_m = scenes[r].domain.dx_m;
-    g.estimated_particle_steps = double(estimate_particle_count(scenes[r])) * double(estimate_step_count(scenes[r]));
+    g.estimated_particle_steps = estimate_particle_steps(scenes[r]);
     g.predicted_wall_s = g.value = NAN;
     g.threads = scenes[r].solver.threads;
   }

@@ -171,7 +171,7 @@ Decision decide(const Parsed& p, const Plan& plan) {
   for (size_t r = 0; r < plan.names.size(); ++r) {
     if (!plan.invalid[r].empty() || d.reused[r]) continue;
     d.todo.push_back(r);
-    particle_steps[r] = double(estimate_particle_count(plan.scenes[r])) * double(estimate_step_count(plan.scenes[r]));
+    particle_steps[r] = estimate_particle_steps(plan.scenes[r]);
   }
   // longest first, so that no long run starts last while the other ranks sit idle
   std::stable_sort(d.todo.begin(), d.todo.end(), [&](size_t a, size_t b) { return particle_steps[a] > particle_steps[b]; });

@@ -59,6 +59,10 @@ int64_t estimate_step_count(const Scene& scene) {
   return int64_t(std::max(steps, 0.0));
 }
 
+double estimate_particle_steps(const Scene& scene) {
+  return double(estimate_particle_count(scene)) * double(std::min<int64_t>(estimate_step_count(scene), scene.solver.max_steps));
+}
+
 Vec2 motion_velocity_m_s(const Motion& motion, double t_s) {
   if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty()) return motion.velocity_m_s;
   const auto& k = motion.path;

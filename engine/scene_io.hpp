@@ -83,6 +83,8 @@ size_t estimate_particle_count(const Scene& scene);
 double estimate_end_time_s(const Scene& scene);
 // ceil(estimate_end_time_s / estimate_time_step_s).
 int64_t estimate_step_count(const Scene& scene);
+// What a run costs: particles x steps, the steps capped by solver.max_steps (cost predictions).
+double estimate_particle_steps(const Scene& scene);
 // A body's extent across its direction of travel (halfway through the run), in cells; its
 // smallest extent if it does not move.
 double body_cells_across(const Scene& scene, const Body& body);
