@@ -1,5 +1,7 @@
 // furrow run: scene file -> Scene -> Simulation -> run directory (+ movies rendered from the
 // stored frames).
+#include <signal.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -72,6 +74,34 @@ int parse_jobs(const Parsed& p) {
   return int(n);
 }
 
+namespace {
+
+volatile sig_atomic_t g_stop_signal = 0;
+void request_stop(int sig) { g_stop_signal = sig; }
+
+// Minutes between checkpoints: default 30; 0 turns them off.
+double checkpoint_interval_s(const Parsed& p) {
+  const std::string text = p.get("--checkpoint-every", "30");
+  char* end = nullptr;
+  const double minutes = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(minutes >= 0.0) || minutes > 1e6)
+    throw UsageError("--checkpoint-every " + text + ": expected minutes of wall time >= 0 (0: no periodic checkpoints)");
+  return 60.0 * minutes;
+}
+
+// A checkpoint another run of DIR left behind, so a run that starts afresh says it could resume.
+std::string checkpoint_left(const fs::path& out_dir) {
+  const fs::path dir = fs::absolute(out_dir).lexically_normal();
+  const std::string prefix = dir.filename().string() + ".partial-";
+  if (!fs::is_directory(dir.parent_path())) return "";
+  for (const auto& e : fs::directory_iterator(dir.parent_path()))
+    if (e.path().filename().string().rfind(prefix, 0) == 0 && fs::exists(e.path() / "checkpoint" / "run.json"))
+      return e.path().string();
+  return "";
+}
+
+}  // namespace
+
 static int run_main(const Parsed& p) {
   Scene scene;
   try {
@@ -84,6 +114,8 @@ static int run_main(const Parsed& p) {
   opt.out_dir = p.get("--out", (fs::path("out") / scene.name).string());
   opt.force = p.has("--force");
   opt.write_paraview = !p.has("--no-paraview");
+  opt.resume = p.has("--resume");
+  opt.checkpoint_interval_s = checkpoint_interval_s(p);
   if (fs::exists(opt.out_dir) && !opt.force) {
     std::cerr << "furrow run: " << opt.out_dir
               << " already exists; pass --out DIR for a new run or --force to replace it\n";
@@ -95,10 +127,41 @@ static int run_main(const Parsed& p) {
   if (!p.has("--quiet") && std::isfinite(predicted_s))
     std::fprintf(stderr, "%s: predicted %s of solver time (%s)\n", scene.name.c_str(), format_duration(predicted_s).c_str(),
                  how.c_str());
+  if (!opt.resume && !p.has("--quiet"))
+    if (const std::string left = checkpoint_left(opt.out_dir); !left.empty())
+      std::fprintf(stderr, "%s holds a checkpoint of a stopped run; this run starts afresh (--resume continues it)\n",
+                   left.c_str());
+  // SIGINT/SIGTERM (Ctrl-C, a batch system's time limit): checkpoint after the current step and
+  // stop; a second signal kills at once
+  struct sigaction sa {};
+  sa.sa_handler = request_stop;
+  sa.sa_flags = SA_RESETHAND;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  opt.stop_requested = [] { return g_stop_signal != 0; };
   ProgressPrinter progress(scene.name, p.has("--quiet"));
   opt.progress = [&](const RunProgress& r) { progress(r); };
-  const RunSummary s = run_scene(scene, opt);
+  RunSummary s;
+  try {
+    s = run_scene(scene, opt);
+  } catch (const std::runtime_error& e) {
+    progress.finish();
+    std::cerr << "furrow run: " << e.what() << "\n";
+    return 1;
+  }
   progress.finish();
+  if (s.resumed_from_step >= 0 && !p.has("--quiet"))
+    std::fprintf(stderr, "%s: resumed from the checkpoint at step %lld\n", scene.name.c_str(),
+                 (long long)s.resumed_from_step);
+  if (s.stopped) {
+    std::fprintf(stderr,
+                 "%s: stopped by signal %d at step %lld (t = %.6g s); checkpoint in %s/checkpoint.\n"
+                 "Continue with the same command and --resume.\n",
+                 scene.name.c_str(), int(g_stop_signal), (long long)s.run_json["steps"].get<int64_t>(),
+                 s.run_json["end_time_s"].get<double>(), s.out_dir.c_str());
+    return 130;  // as study: stopped by the user
+  }
 
   const auto& j = s.run_json;
   std::printf("%s: %zu particles, %lld steps, dt %.3g..%.3g s, %.1f s wall, %.2f M particle-steps/s", scene.name.c_str(),
@@ -135,11 +198,19 @@ Command command_run() {
             "  movies/      <field>.mp4 for each field in outputs.movies\n"
             "  run.json     particles, steps, dt range, wall time, particle-steps/s, peak memory, force summary\n"
             "The run is built under DIR.partial-PID and renamed into place when complete; an existing DIR\n"
-            "is never overwritten unless --force is given. A scene with errors writes nothing.",
+            "is never overwritten unless --force is given. A scene with errors writes nothing.\n"
+            "Checkpoints: every --checkpoint-every minutes, and on SIGINT or SIGTERM (Ctrl-C, a batch\n"
+            "system's time limit), the run's whole state goes to DIR.partial-PID/checkpoint; a signal then\n"
+            "stops the run with exit status 130. The same command with --resume continues from there with\n"
+            "results identical to an uninterrupted run (any thread count); run.json's wall and solver\n"
+            "seconds are summed over the segments.",
             {{"--out", true, false, "run directory (default out/<scene name>)", "DIR"},
              {"--force", false, false, "replace an existing run directory once the new run completes"},
              {"--no-movies", false, false, "skip rendering movies"},
-             {"--no-paraview", false, false, "skip the ParaView .vti/.pvd files"}},
+             {"--no-paraview", false, false, "skip the ParaView .vti/.pvd files"},
+             {"--resume", false, false, "continue a stopped run of this scene from its checkpoint (none: start afresh)"},
+             {"--checkpoint-every", true, false, "minutes of wall time between checkpoints (default 30; 0: only on a signal)",
+              "MIN"}},
             1, 1, run_main};
   for (auto& o : scene_run_options()) c.options.push_back(o);
   return c;

@@ -428,6 +428,27 @@ void RunAnalysis::add_frame(const FieldFrame& frame, double travel_m, const Vec2
   frames_.push_back(e);
 }
 
+double double_from_json(const nlohmann::json& j) {
+  return j.is_null() ? std::numeric_limits<double>::quiet_NaN() : j.get<double>();
+}
+
+std::vector<double> doubles_from_json(const nlohmann::json& j) {
+  std::vector<double> v;
+  v.reserve(j.size());
+  for (const auto& x : j) v.push_back(double_from_json(x));
+  return v;
+}
+
+nlohmann::json RunAnalysis::state() const {
+  return {{"travel_m", travel_m_}, {"drag_N_per_m", drag_N_per_m_}, {"frames", frames_}};
+}
+
+void RunAnalysis::restore(const nlohmann::json& j) {
+  travel_m_ = doubles_from_json(j.at("travel_m"));
+  drag_N_per_m_ = doubles_from_json(j.at("drag_N_per_m"));
+  frames_ = j.at("frames");
+}
+
 nlohmann::json RunAnalysis::to_json() const {
   if (lead_ < 0) return nullptr;
   DragStatsOptions o;
@@ -565,6 +586,18 @@ void CollapseAnalysis::add_step(double t_s, const ParticleView& p, bool last) {
   profile_x_m_.clear();
   profile_height_m_.clear();
   for (const auto& [x, h] : surface) profile_x_m_.push_back(x), profile_height_m_.push_back(h);
+}
+
+nlohmann::json CollapseAnalysis::state() const {
+  nlohmann::json samples = nlohmann::json::array();
+  for (const auto& c : samples_) samples.push_back({c.t_s, c.front_m, c.height_m});
+  return {{"next_s", next_s_}, {"samples", samples}};
+}
+
+void CollapseAnalysis::restore(const nlohmann::json& j) {
+  next_s_ = j.at("next_s").get<double>();
+  samples_.clear();
+  for (const auto& c : j.at("samples")) samples_.push_back({double_from_json(c.at(0)), double_from_json(c.at(1)), double_from_json(c.at(2))});
 }
 
 nlohmann::json CollapseAnalysis::to_json() const {

@@ -113,6 +113,11 @@ ForceSmoothness force_smoothness(const std::vector<double>& travel_m, const std:
 // Whether a step at time t_s with lead-body travel travel_m lies in the scene's averaging window
 // (outputs.average_window: by displacement when from_m >= 0, else by time; a negative "to" means
 // the end of the run).
+// JSON has no NaN: a NaN is written as null (nlohmann's dump) and read back here as NaN; finite
+// doubles round-trip exactly (17 significant digits). For run checkpoints.
+double double_from_json(const nlohmann::json& j);
+std::vector<double> doubles_from_json(const nlohmann::json& j);
+
 bool in_average_window(const Outputs& out, double t_s, double travel_m);
 
 // ---------------------------------------------------------------- rigid wedge under a plate
@@ -193,6 +198,9 @@ class CollapseAnalysis {
   void add_step(double t_s, const ParticleView& p, bool last = false);
   nlohmann::json to_json() const;
   const std::vector<CollapseSample>& samples() const { return samples_; }
+  // what a resumed run needs to continue the same samples (run checkpoints)
+  nlohmann::json state() const;
+  void restore(const nlohmann::json& state);
 
  private:
   CollapseGeometry g_;
@@ -220,6 +228,8 @@ class RunAnalysis {
   // a frame just rasterized; bodies as in frame.bodies, lead body's velocity
   void add_frame(const FieldFrame& frame, double travel_m, const Vec2& velocity_m_s);
   nlohmann::json to_json() const;
+  nlohmann::json state() const;
+  void restore(const nlohmann::json& state);
 
  private:
   int lead_ = -1;

@@ -1,10 +1,12 @@
 #include "engine/run.hpp"
 
+#include <signal.h>
 #include <sys/resource.h>
 #include <tbb/info.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -46,11 +48,21 @@ namespace {
 // Averages forces over output intervals and writes one CSV row per body per interval.
 class ForceLog {
  public:
-  ForceLog(const std::string& path, const Scene& s) : out_(path), interval_s_(s.outputs.force_interval_s) {
-    if (!out_) throw std::runtime_error(path + ": cannot open for writing");
-    out_ << "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m\n";
+  // state: a checkpoint's, to append after the rows it had written; null for a new file
+  ForceLog(const std::string& path, const Scene& s, const nlohmann::json& state)
+      : path_(path), interval_s_(s.outputs.force_interval_s) {
     sum_.assign(s.bodies.size(), Vec2(0, 0));
     for (const auto& b : s.bodies) names_.push_back(b.name);
+    if (state.is_null()) {
+      out_.open(path, std::ios::trunc);
+      out_ << "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m\n";
+    } else {
+      fs::resize_file(path, state.at("bytes").get<uintmax_t>());
+      out_.open(path, std::ios::app);
+      span_s_ = state.at("span_s").get<double>();
+      for (size_t b = 0; b < sum_.size(); ++b) sum_[b] = Vec2(state.at("sum")[b][0], state.at("sum")[b][1]);
+    }
+    if (!out_) throw std::runtime_error(path + ": cannot open for writing");
   }
   void add(const Simulation& sim) {
     const auto& bodies = sim.bodies();
@@ -73,12 +85,20 @@ class ForceLog {
     }
     span_s_ = 0.0;
   }
+  nlohmann::json state() {
+    out_.flush();
+    if (!out_) throw std::runtime_error(path_ + ": write failed");
+    nlohmann::json sum = nlohmann::json::array();
+    for (const Vec2& v : sum_) sum.push_back({v.x(), v.y()});
+    return {{"bytes", fs::file_size(path_)}, {"span_s", span_s_}, {"sum", sum}};
+  }
   void close() {
     out_.close();
     if (!out_) throw std::runtime_error("forces.csv: write failed");
   }
 
  private:
+  std::string path_;
   std::ofstream out_;
   double interval_s_ = 0.0, span_s_ = 0.0;
   std::vector<Vec2> sum_;
@@ -111,6 +131,23 @@ class ForceStats {
     }
     if (in_window) window_s_ += dt;
   }
+  nlohmann::json state() const {
+    nlohmann::json b = nlohmann::json::array();
+    for (size_t k = 0; k < bodies_.size(); ++k)
+      b.push_back({{"peak", {bodies_[k].peak_N_per_m.x(), bodies_[k].peak_N_per_m.y()}},
+                   {"sum", {sums_[k].x(), sums_[k].y()}},
+                   {"samples", bodies_[k].window_samples}});
+    return {{"bodies", b}, {"window_s", window_s_}};
+  }
+  void restore(const nlohmann::json& j) {
+    window_s_ = j.at("window_s").get<double>();
+    for (size_t k = 0; k < bodies_.size(); ++k) {
+      const auto& b = j.at("bodies").at(k);
+      bodies_[k].peak_N_per_m = Vec2(b.at("peak")[0], b.at("peak")[1]);
+      sums_[k] = Vec2(b.at("sum")[0], b.at("sum")[1]);
+      bodies_[k].window_samples = b.at("samples").get<int64_t>();
+    }
+  }
   std::vector<BodyForceSummary> finish() {
     for (size_t b = 0; b < bodies_.size(); ++b)
       bodies_[b].mean_N_per_m = window_s_ > 0.0 ? Vec2(sums_[b] / window_s_)
@@ -130,6 +167,43 @@ nlohmann::json vec_json(const Vec2& v) {
   return nlohmann::json::array({num(v.x()), num(v.y())});
 }
 
+bool process_running(long pid) { return pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM); }
+
+// The DIR.partial-* holding a checkpoint of this scene (the furthest along), or an empty path.
+fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene) {
+  const std::string prefix = final_dir.filename().string() + ".partial-", hash = scene_hash(scene);
+  fs::path best;
+  int64_t best_steps = -1;
+  if (!fs::is_directory(final_dir.parent_path())) return best;
+  for (const auto& e : fs::directory_iterator(final_dir.parent_path())) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    // a crash between the two renames of save_checkpoint leaves only checkpoint.old: still whole
+    if (!fs::exists(e.path() / "checkpoint") && fs::exists(e.path() / "checkpoint.old" / "run.json"))
+      fs::rename(e.path() / "checkpoint.old", e.path() / "checkpoint");
+    const fs::path state = e.path() / "checkpoint" / "run.json";
+    if (!fs::exists(state)) continue;
+    const long pid = std::strtol(name.c_str() + prefix.size(), nullptr, 10);
+    if (pid != long(getpid()) && process_running(pid))
+      throw std::runtime_error(e.path().string() + " is still being written by process " + std::to_string(pid) +
+                               ": stop it first or choose another --out");
+    std::ifstream in(state);
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(in);
+    } catch (const std::exception& x) {
+      throw std::runtime_error(state.string() + ": cannot be read (" + x.what() + "); remove " + e.path().string() +
+                               " to start afresh");
+    }
+    if (j.value("scene_hash", std::string()) != hash)
+      throw std::runtime_error(e.path().string() + " holds a checkpoint of a different scene (scene_hash " +
+                               j.value("scene_hash", std::string("?")) + ", this scene " + hash +
+                               "): remove it or choose another --out");
+    if (j.value("steps", int64_t(-1)) > best_steps) best = e.path(), best_steps = j.value("steps", int64_t(-1));
+  }
+  return best;
+}
+
 }  // namespace
 
 RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
@@ -139,14 +213,34 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   if (fs::exists(final_dir) && !opt.force)
     throw std::runtime_error(final_dir.string() + " already exists: choose another --out or pass --force to replace it");
   const fs::path tmp_dir = final_dir.string() + ".partial-" + std::to_string(getpid());
-  fs::remove_all(tmp_dir);
-  fs::create_directories(tmp_dir / "frames");
-
-  write_file_atomic((tmp_dir / "scene.json").string(), format_scene(scene));
+  const fs::path checkpoint_dir = tmp_dir / "checkpoint";
+  nlohmann::json resumed;  // the checkpoint's run state; null for a new run
+  if (opt.resume) {
+    const fs::path from = find_checkpoint(final_dir, scene);
+    if (!from.empty()) {
+      if (from != tmp_dir) {
+        fs::remove_all(tmp_dir);
+        fs::rename(from, tmp_dir);
+      }
+      std::ifstream in(checkpoint_dir / "run.json");
+      resumed = nlohmann::json::parse(in);
+    }
+  }
+  if (resumed.is_null()) {
+    fs::remove_all(tmp_dir);
+    fs::create_directories(tmp_dir / "frames");
+    write_file_atomic((tmp_dir / "scene.json").string(), format_scene(scene));
+  }
 
   const auto wall0 = clock::now();
   Simulation sim(scene);
-  ForceLog forces((tmp_dir / "forces.csv").string(), scene);
+  if (!resumed.is_null()) {
+    const std::string path = (checkpoint_dir / "simulation.bin").string();
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path + ": cannot open");
+    sim.load_state(in, path);
+  }
+  ForceLog forces((tmp_dir / "forces.csv").string(), scene, resumed.is_null() ? resumed : resumed.at("forces"));
   ForceStats stats(scene);
   RunAnalysis analysis(scene);  // run.json "analysis": drag statistics, wedge per frame
   CollapseAnalysis collapse(scene);  // run.json "collapse": runout and height of a released column
@@ -189,6 +283,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     return std::min(f, 1.0);
   };
   double dt_min = std::numeric_limits<double>::max(), dt_max = 0.0;
+  double wall_before_s = 0.0, solver_before_s = 0.0;  // earlier segments of a resumed run
+  int segments = 1;
+  const double fraction0 = fraction();
   auto last_report = clock::now();
   auto report = [&](bool force_report) {
     if (!opt.progress) return;
@@ -199,19 +296,69 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     p.fraction = fraction();
     p.time_s = sim.time_s();
     p.steps = sim.step_count();
-    p.wall_s = std::chrono::duration<double>(now - wall0).count();
-    p.eta_s = p.fraction > 0.01 ? p.wall_s * (1.0 - p.fraction) / p.fraction : -1.0;
+    const double segment_s = std::chrono::duration<double>(now - wall0).count();
+    p.wall_s = wall_before_s + segment_s;
+    p.eta_s = p.fraction - fraction0 > 0.01 ? segment_s * (1.0 - p.fraction) / (p.fraction - fraction0) : -1.0;
     p.particles = sim.particles().size();
     p.dt_s = sim.last_dt_s();
     opt.progress(p);
   };
 
-  if (frames_on) write_frame();
-  if (collapse.active()) collapse.add_step(0.0, sim.particle_view());
-  const auto loop0 = clock::now();
   int64_t contact_sweeps = 0, contact_unconverged = 0, contact_points_max = 0;
   int contact_sweeps_max = 0;
   double contact_residual_max = 0.0;
+  RunSummary summary;
+  if (!resumed.is_null()) {
+    summary.resumed_from_step = sim.step_count();
+    const auto& r = resumed;
+    frame_index = r.at("frame_index").get<int64_t>();
+    next_frame_s = r.at("next_frame_s").get<double>();
+    for (const auto& e : r.at("pvd")) pvd.push_back({e.at(0).get<double>(), e.at(1).get<std::string>()});
+    dt_min = r.at("dt_min_s").get<double>(), dt_max = r.at("dt_max_s").get<double>();
+    const auto& c = r.at("contact");
+    contact_sweeps = c.at(0), contact_unconverged = c.at(1), contact_points_max = c.at(2);
+    contact_sweeps_max = c.at(3), contact_residual_max = c.at(4);
+    wall_before_s = r.at("wall_seconds").get<double>();
+    solver_before_s = r.at("solver_seconds").get<double>();
+    segments = r.at("segments").get<int>() + 1;
+    stats.restore(r.at("stats"));
+    analysis.restore(r.at("analysis"));
+    collapse.restore(r.at("collapse"));
+  } else {
+    if (frames_on) write_frame();
+    if (collapse.active()) collapse.add_step(0.0, sim.particle_view());
+  }
+  const auto loop0 = clock::now();
+  // The run's state after a step, written beside the old checkpoint and swapped in by two renames
+  // (find_checkpoint takes checkpoint.old if a crash falls between them).
+  auto save_checkpoint = [&] {
+    const fs::path fresh = tmp_dir / "checkpoint.new", old = tmp_dir / "checkpoint.old";
+    fs::remove_all(fresh);
+    fs::create_directories(fresh);
+    {
+      std::ofstream f(fresh / "simulation.bin", std::ios::binary);
+      sim.save_state(f);
+      f.close();
+      if (!f) throw std::runtime_error((fresh / "simulation.bin").string() + ": write failed");
+    }
+    nlohmann::json pvd_json = nlohmann::json::array();
+    for (const auto& e : pvd) pvd_json.push_back({e.time_s, e.file});
+    const nlohmann::json j = {
+        {"scene_hash", scene_hash(scene)}, {"steps", sim.step_count()}, {"time_s", sim.time_s()},
+        {"frame_index", frame_index}, {"next_frame_s", next_frame_s}, {"pvd", pvd_json},
+        {"dt_min_s", dt_min}, {"dt_max_s", dt_max},
+        {"contact", {contact_sweeps, contact_unconverged, contact_points_max, contact_sweeps_max, contact_residual_max}},
+        {"wall_seconds", wall_before_s + std::chrono::duration<double>(clock::now() - wall0).count()},
+        {"solver_seconds", solver_before_s + std::chrono::duration<double>(clock::now() - loop0).count()},
+        {"segments", segments}, {"forces", forces.state()}, {"stats", stats.state()},
+        {"analysis", analysis.state()}, {"collapse", collapse.state()}};
+    write_file_atomic((fresh / "run.json").string(), j.dump() + "\n");
+    fs::remove_all(old);
+    if (fs::exists(checkpoint_dir)) fs::rename(checkpoint_dir, old);
+    fs::rename(fresh, checkpoint_dir);
+    fs::remove_all(old);
+  };
+  auto last_checkpoint = clock::now();
   while (!sim.finished()) {
     sim.step();
     const StepStats& st = sim.stats();
@@ -231,17 +378,30 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     if (frames_on && sim.time_s() >= next_frame_s - 1e-12) write_frame();
     if (collapse.active()) collapse.add_step(sim.time_s(), sim.particle_view());
     report(false);
+    const bool stop = opt.stop_requested && opt.stop_requested();
+    if (stop || (opt.checkpoint_interval_s > 0.0 &&
+                 std::chrono::duration<double>(clock::now() - last_checkpoint).count() >= opt.checkpoint_interval_s)) {
+      save_checkpoint();
+      last_checkpoint = clock::now();
+    }
+    if (stop && !sim.finished()) {
+      report(true);
+      summary.stopped = true;
+      summary.out_dir = tmp_dir.string();
+      summary.run_json = {{"steps", sim.step_count()}, {"end_time_s", sim.time_s()}};
+      return summary;
+    }
   }
-  const double loop_s = std::chrono::duration<double>(clock::now() - loop0).count();
+  const double loop_s = solver_before_s + std::chrono::duration<double>(clock::now() - loop0).count();
   if (collapse.active()) collapse.add_step(sim.time_s(), sim.particle_view(), true);
   forces.flush(sim);
   forces.close();
   report(true);
   if (opt.write_paraview && !pvd.empty()) write_pvd((tmp_dir / "frames.pvd").string(), pvd);
 
-  RunSummary summary;
+  fs::remove_all(checkpoint_dir);  // a finished run keeps no checkpoint
   summary.bodies = stats.finish();
-  const double wall_s = std::chrono::duration<double>(clock::now() - wall0).count();
+  const double wall_s = wall_before_s + std::chrono::duration<double>(clock::now() - wall0).count();
   const double psteps = double(sim.particles().size()) * double(sim.step_count());
   auto& j = summary.run_json;
   j["scene"] = scene.name;
@@ -255,6 +415,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   j["wave_speed_m_s"] = sim.wave_speed_m_s();
   j["wall_seconds"] = wall_s;
   j["solver_seconds"] = loop_s;
+  j["segments"] = segments;  // > 1: resumed from checkpoints; the seconds are summed over them
   j["particle_steps_per_second"] = loop_s > 0.0 ? psteps / loop_s : 0.0;
   j["threads"] = scene.solver.threads > 0 ? scene.solver.threads : tbb::info::default_concurrency();
   j["peak_resident_bytes"] = peak_resident_bytes();

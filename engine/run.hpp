@@ -30,6 +30,14 @@ struct RunOptions {
   // Called from the running thread after frame `index` is stored complete at `path` (inside the
   // temporary directory until the run is renamed into place): a viewer can follow the run.
   std::function<void(int64_t index, const std::string& path)> frame_written;
+  // Checkpoints: the run's whole state saved in DIR.partial-PID/checkpoint every
+  // `checkpoint_interval_s` wall seconds (0: never) and when stop_requested() returns true (polled
+  // after every step; run_scene then returns with RunSummary::stopped). `resume`: continue from the
+  // checkpoint of this scene in a DIR.partial-* left by a stopped or killed run, bit-identically;
+  // without one the run starts afresh.
+  double checkpoint_interval_s = 0.0;
+  std::function<bool()> stop_requested;
+  bool resume = false;
 };
 
 // Per-body force summary over the scene's averaging window.
@@ -41,12 +49,15 @@ struct BodyForceSummary {
 };
 
 struct RunSummary {
-  nlohmann::json run_json;  // what run.json holds
+  nlohmann::json run_json;  // what run.json holds (stopped: only steps and end_time_s)
   std::vector<BodyForceSummary> bodies;
-  std::string out_dir;
+  std::string out_dir;            // stopped: the DIR.partial-PID holding the checkpoint
+  bool stopped = false;           // stop_requested() ended the run before its end
+  int64_t resumed_from_step = -1; // the checkpoint's step when resumed, else -1
 };
 
-// Throws std::runtime_error when out_dir exists and !force, or when an output cannot be written.
+// Throws std::runtime_error when out_dir exists and !force, when an output cannot be written, or
+// (resume) when a DIR.partial-* checkpoint belongs to another scene or a process still running.
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
 // The resolved scene without what cannot change a run's results (solver.threads: runs are

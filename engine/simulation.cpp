@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <istream>
+#include <ostream>
 #include <numeric>
 #include <stdexcept>
 #include <tuple>
@@ -1004,6 +1006,98 @@ void Simulation::reorder_particles() {
     });
     a.swap(buffer);
   });
+}
+
+namespace {
+
+constexpr char kCheckpointMagic[8] = {'F', 'U', 'R', 'R', 'O', 'W', 'C', 'K'};
+constexpr uint32_t kCheckpointVersion = 1;
+
+template <class T> void put(std::ostream& out, const T& v) {
+  static_assert(std::is_trivially_destructible_v<T> && !std::is_pointer_v<T>);  // plain values (Eigen's fixed-size too)
+  out.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T> void put_vector(std::ostream& out, const std::vector<T>& v) {
+  static_assert(std::is_trivially_destructible_v<T> && !std::is_pointer_v<T>);  // plain values (Eigen's fixed-size too)
+  put(out, uint64_t(v.size()));
+  out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
+}
+
+// Reads what put/put_vector wrote; every failure names the file and the item.
+struct Reader {
+  std::istream& in;
+  const std::string& what;
+  [[noreturn]] void fail(const std::string& item, const std::string& why) const {
+    throw std::runtime_error(what + ": " + item + ": " + why);
+  }
+  template <class T> T get(const std::string& item) {
+    T v;
+    if (!in.read(reinterpret_cast<char*>(&v), sizeof v)) fail(item, "file ends early");
+    return v;
+  }
+  // `expected`: the element count this simulation has (SIZE_MAX: any)
+  template <class T> void get_vector(std::vector<T>& v, const std::string& item, size_t expected = SIZE_MAX) {
+    const uint64_t n = get<uint64_t>(item);
+    if (expected != SIZE_MAX && n != expected)
+      fail(item, std::to_string(n) + " values where this scene has " + std::to_string(expected));
+    if (n > (uint64_t(1) << 40)) fail(item, "implausible length " + std::to_string(n));
+    v.resize(size_t(n));
+    if (!in.read(reinterpret_cast<char*>(v.data()), std::streamsize(n * sizeof(T)))) fail(item, "file ends early");
+  }
+};
+
+}  // namespace
+
+void Simulation::save_state(std::ostream& out) const {
+  out.write(kCheckpointMagic, sizeof kCheckpointMagic);
+  put(out, kCheckpointVersion);
+  put(out, uint64_t(p_.size()));
+  p_.for_each_array([&](const char* name, const auto& a) {
+    put(out, uint32_t(sizeof(a[0])));
+    put(out, uint32_t(std::strlen(name)));
+    out.write(name, std::streamsize(std::strlen(name)));
+    put_vector(out, a);
+  });
+  put(out, t_s_), put(out, dt_s_), put(out, steps_), put(out, stats_), put(out, phase_s_), put(out, wall_forces_);
+  put_vector(out, bodies_);
+  put(out, uint64_t(touched_.size()));
+  for (const auto& t : touched_) put_vector(out, t);
+  put_vector(out, contacts_);
+}
+
+void Simulation::load_state(std::istream& in, const std::string& what) {
+  Reader r{in, what};
+  char magic[sizeof kCheckpointMagic];
+  if (!in.read(magic, sizeof magic) || std::memcmp(magic, kCheckpointMagic, sizeof magic) != 0)
+    r.fail("header", "not a Furrow checkpoint");
+  if (const auto v = r.get<uint32_t>("version"); v != kCheckpointVersion)
+    r.fail("version", std::to_string(v) + ", this build reads " + std::to_string(kCheckpointVersion));
+  const uint64_t n = r.get<uint64_t>("particle count");
+  if (n != p_.size())
+    r.fail("particle count", std::to_string(n) + " points where this scene seeds " + std::to_string(p_.size()));
+  p_.for_each_array([&](const char* name, auto& a) {
+    const auto bytes = r.get<uint32_t>(std::string(name) + " element size");
+    if (bytes != sizeof(a[0]))
+      r.fail(name, std::to_string(bytes) + "-byte values where this build stores " + std::to_string(sizeof(a[0])) +
+                       " (written by a build with the other FURROW_FLOAT_STATE)");
+    std::string stored(r.get<uint32_t>(std::string(name) + " name length"), '\0');
+    if (!in.read(stored.data(), std::streamsize(stored.size())) || stored != name)
+      r.fail(name, "found array '" + stored + "' in its place");
+    // an array this run does not keep (no output needs it) must be absent in the file too
+    r.get_vector(a, name, a.empty() ? 0 : p_.size());
+  });
+  t_s_ = r.get<double>("time"), dt_s_ = r.get<double>("dt"), steps_ = r.get<int64_t>("steps");
+  stats_ = r.get<StepStats>("step statistics"), phase_s_ = r.get<PhaseSeconds>("phase seconds");
+  wall_forces_ = r.get<std::array<Vec2, 4>>("wall forces");
+  r.get_vector(bodies_, "bodies", bodies_.size());
+  const auto marks = r.get<uint64_t>("contact marks");
+  if (marks > bodies_.size()) r.fail("contact marks", std::to_string(marks) + " bodies' marks");
+  touched_.resize(size_t(marks));
+  for (auto& t : touched_) r.get_vector(t, "contact marks", g_.node.size());
+  r.get_vector(contacts_, "contact points");
+  for (const auto& c : contacts_)
+    if (c.particle >= p_.size() || c.body >= bodies_.size()) r.fail("contact points", "a point out of range");
+  if (in.peek() != std::char_traits<char>::eof()) r.fail("end", "data after the last item");
 }
 
 size_t Simulation::state_bytes() const {

@@ -6,7 +6,9 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "engine/fields.hpp"
@@ -152,6 +154,13 @@ class Simulation {
   double wave_speed_m_s() const { return wave_speed_; }
   // distance travelled by the first moving body (m), for end_displacement and averaging windows
   double lead_body_travel_m() const;
+
+  // Checkpoint: everything a later step depends on (particles in their current order, bodies,
+  // time, the dt limiter's last speed, contact warm starts and marks), so a simulation built from
+  // the same scene and loaded continues bit-identically. load_state throws std::runtime_error
+  // naming `what` when the stream is not a checkpoint of this build and scene size.
+  void save_state(std::ostream& out) const;
+  void load_state(std::istream& in, const std::string& what);
 
   // diagnostics
   size_t state_bytes() const;  // particle, grid and sorting arrays actually allocated

@@ -1,0 +1,168 @@
+// Run checkpoints: a run stopped after some steps and resumed must write exactly what the
+// uninterrupted run writes (forces.csv byte for byte, run.json's forces and analysis, frames), for
+// every contact method: each keeps different state across steps (particle contact warm-starts its
+// impulses, cell_fraction keeps the nodes a point has touched).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "engine/run.hpp"
+#include "engine/simulation.hpp"
+#include "test_scenes.hpp"
+
+using namespace furrow;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A DPM bed (dilatancy on: phi_d is state) with a plate pushed in at an angle, velocity frames (the
+// wedge analysis keeps per-frame state) and a force interval that is not a multiple of dt (the
+// force log carries a partial sum across the stop).
+Scene checkpoint_scene(ContactMethod contact) {
+  Material m = test_scenes::glass_beads(0.4);
+  m.model = MaterialModel::DPM;
+  m.chi = 5.0;
+  m.phi_min = 0.45;
+  Scene s = test_scenes::bed_scene(m, 0.1, 0.05, 0.02, 0.005, 1.0, 0.62);
+  s.name = "checkpoint";
+  s.effects.dilatancy = true;
+  s.solver.contact = contact;
+  s.bodies.push_back(test_scenes::plate(0.02, 0.01, 0.05, 0.051, Vec2(0.02, -0.1)));
+  s.solver.end_displacement_m = 0.012;
+  s.outputs.fields = {"velocity", "packing_fraction"};
+  s.outputs.frame_interval_s = 0.02;
+  s.outputs.force_interval_s = 0.00123;
+  s.outputs.average_from_m = 0.004;
+  return s;
+}
+
+struct Dirs {
+  fs::path root;
+  explicit Dirs(const std::string& name)
+      : root(fs::temp_directory_path() / ("furrow_checkpoint_test_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(root);
+    fs::create_directories(root);
+  }
+  ~Dirs() { fs::remove_all(root); }
+};
+
+RunOptions options(const fs::path& dir) {
+  RunOptions o;
+  o.out_dir = dir.string();
+  return o;
+}
+
+}  // namespace
+
+class Checkpoint : public ::testing::TestWithParam<ContactMethod> {};
+
+TEST_P(Checkpoint, StoppedAndResumedRunWritesWhatTheUninterruptedRunWrites) {
+  const Scene s = checkpoint_scene(GetParam());
+  Dirs d(contact_method_name(GetParam()));
+  const RunSummary whole = run_scene(s, options(d.root / "whole"));
+  const int64_t steps = whole.run_json.at("steps").get<int64_t>();
+  ASSERT_GT(steps, 100);
+
+  // stop twice (a third and two thirds of the way), then finish; one thread, then two
+  int64_t polled = 0;
+  RunOptions o = options(d.root / "split");
+  o.resume = true;
+  o.stop_requested = [&] { return ++polled == steps / 3; };
+  RunSummary part = run_scene(s, o);
+  ASSERT_TRUE(part.stopped);
+  EXPECT_EQ(part.resumed_from_step, -1);
+  EXPECT_EQ(part.run_json.at("steps").get<int64_t>(), steps / 3);
+  EXPECT_TRUE(fs::exists(fs::path(part.out_dir) / "checkpoint" / "simulation.bin"));
+  EXPECT_FALSE(fs::exists(d.root / "split"));  // nothing in place until the run completes
+  polled = 0;
+  Scene two_threads = s;
+  two_threads.solver.threads = 2;
+  part = run_scene(two_threads, o);
+  ASSERT_TRUE(part.stopped);
+  EXPECT_EQ(part.resumed_from_step, steps / 3);
+  o.stop_requested = nullptr;
+  const RunSummary resumed = run_scene(s, o);
+  ASSERT_FALSE(resumed.stopped);
+  EXPECT_EQ(resumed.resumed_from_step, 2 * (steps / 3));
+
+  const fs::path a = d.root / "whole", b = d.root / "split";
+  EXPECT_EQ(read_bytes(a / "forces.csv"), read_bytes(b / "forces.csv"));
+  const auto& ja = whole.run_json;
+  const auto& jb = resumed.run_json;
+  for (const char* key : {"steps", "end_time_s", "dt_min_s", "dt_max_s", "frames", "bodies", "analysis", "lead_body_travel_m"})
+    EXPECT_EQ(ja.at(key), jb.at(key)) << key;
+  if (ja.contains("contact")) {
+    EXPECT_EQ(ja.at("contact"), jb.at("contact"));
+  }
+  EXPECT_EQ(jb.at("segments").get<int>(), 3);
+  EXPECT_EQ(read_bytes(a / "frames.pvd"), read_bytes(b / "frames.pvd"));
+  for (int64_t f = 0; f < ja.at("frames").get<int64_t>(); ++f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%05lld.vti", (long long)f);
+    EXPECT_EQ(read_bytes(a / "frames" / name), read_bytes(b / "frames" / name)) << name;
+  }
+  EXPECT_FALSE(fs::exists(b / "checkpoint"));  // a finished run keeps no checkpoint
+}
+
+INSTANTIATE_TEST_SUITE_P(Contact, Checkpoint,
+                         ::testing::Values(ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction),
+                         [](const auto& info) { return std::string(contact_method_name(info.param)); });
+
+// A checkpoint is refused, with the file and the item named, when it is not of this scene.
+TEST(CheckpointErrors, OtherSceneAndDamagedFilesAreNamed) {
+  Scene s = checkpoint_scene(ContactMethod::Node);
+  s.solver.end_displacement_m = 0.003;
+  Dirs d("errors");
+  RunOptions o = options(d.root / "run");
+  o.resume = true;
+  int64_t polled = 0;
+  o.stop_requested = [&] { return ++polled == 20; };
+  const RunSummary part = run_scene(s, o);
+  ASSERT_TRUE(part.stopped);
+  o.stop_requested = nullptr;
+
+  Scene other = s;
+  other.bodies[0].friction = 0.2;
+  try {
+    run_scene(other, o);
+    ADD_FAILURE() << "a checkpoint of another scene was resumed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("different scene"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(part.out_dir), std::string::npos) << e.what();
+  }
+
+  // the simulation state of a scene with more particles
+  Simulation sim(s);
+  Scene bigger = s;
+  bigger.domain.width_m = 0.12;
+  bigger.beds[0].max_m.x() = 0.12;
+  Simulation big(bigger);
+  std::stringstream state;
+  big.save_state(state);
+  try {
+    sim.load_state(state, "state.bin");
+    ADD_FAILURE() << "a checkpoint of another bed loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("state.bin: particle count"), std::string::npos) << e.what();
+  }
+  // cut short
+  std::stringstream full;
+  sim.save_state(full);
+  std::stringstream cut(full.str().substr(0, full.str().size() / 2));
+  try {
+    sim.load_state(cut, "cut.bin");
+    ADD_FAILURE() << "a truncated checkpoint loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("file ends early"), std::string::npos) << e.what();
+  }
+}
