@@ -81,7 +81,9 @@ struct Grid {
   int NX = 0, NY = 0;      // nodes including padding
   double dx = 0.0;
   std::vector<GridNode> node;
-  size_t index(int i, int j) const { return size_t(j + kPad) * NX + size_t(i + kPad); }
+  size_t index(int i, int j) const { return index(i, j, size_t(NX)); }
+  // the same with the row length held by the caller (a local the hot loops keep in a register)
+  static size_t index(int i, int j, size_t NX) { return size_t(j + kPad) * NX + size_t(i + kPad); }
   double node_x(size_t k) const { return (int(k % NX) - kPad) * dx; }
   double node_y(size_t k) const { return (int(k / NX) - kPad) * dx; }
 };
