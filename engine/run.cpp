@@ -284,6 +284,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   };
   double dt_min = std::numeric_limits<double>::max(), dt_max = 0.0;
   double wall_before_s = 0.0, solver_before_s = 0.0;  // earlier segments of a resumed run
+  double checkpoint_s = 0.0;  // writing checkpoints, all segments: not solver time
   int segments = 1;
   const double fraction0 = fraction();
   auto last_report = clock::now();
@@ -320,6 +321,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     contact_sweeps_max = c.at(3), contact_residual_max = c.at(4);
     wall_before_s = r.at("wall_seconds").get<double>();
     solver_before_s = r.at("solver_seconds").get<double>();
+    checkpoint_s = r.value("checkpoint_seconds", 0.0);
     segments = r.at("segments").get<int>() + 1;
     stats.restore(r.at("stats"));
     analysis.restore(r.at("analysis"));
@@ -331,7 +333,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   const auto loop0 = clock::now();
   // The run's state after a step, written beside the old checkpoint and swapped in by two renames
   // (find_checkpoint takes checkpoint.old if a crash falls between them).
+  double segment_checkpoint_s = 0.0;
   auto save_checkpoint = [&] {
+    const auto t0 = clock::now();
     const fs::path fresh = tmp_dir / "checkpoint.new", old = tmp_dir / "checkpoint.old";
     fs::remove_all(fresh);
     fs::create_directories(fresh);
@@ -349,14 +353,18 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
         {"dt_min_s", dt_min}, {"dt_max_s", dt_max},
         {"contact", {contact_sweeps, contact_unconverged, contact_points_max, contact_sweeps_max, contact_residual_max}},
         {"wall_seconds", wall_before_s + std::chrono::duration<double>(clock::now() - wall0).count()},
-        {"solver_seconds", solver_before_s + std::chrono::duration<double>(clock::now() - loop0).count()},
-        {"segments", segments}, {"forces", forces.state()}, {"stats", stats.state()},
+        {"solver_seconds",
+         solver_before_s + std::chrono::duration<double>(t0 - loop0).count() - segment_checkpoint_s},
+        {"segments", segments}, {"checkpoint_seconds", checkpoint_s}, {"forces", forces.state()}, {"stats", stats.state()},
         {"analysis", analysis.state()}, {"collapse", collapse.state()}};
     write_file_atomic((fresh / "run.json").string(), j.dump() + "\n");
     fs::remove_all(old);
     if (fs::exists(checkpoint_dir)) fs::rename(checkpoint_dir, old);
     fs::rename(fresh, checkpoint_dir);
     fs::remove_all(old);
+    const double took = std::chrono::duration<double>(clock::now() - t0).count();
+    segment_checkpoint_s += took;
+    checkpoint_s += took;
   };
   auto last_checkpoint = clock::now();
   while (!sim.finished()) {
@@ -392,7 +400,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
       return summary;
     }
   }
-  const double loop_s = solver_before_s + std::chrono::duration<double>(clock::now() - loop0).count();
+  const double loop_s =
+      solver_before_s + std::chrono::duration<double>(clock::now() - loop0).count() - segment_checkpoint_s;
   if (collapse.active()) collapse.add_step(sim.time_s(), sim.particle_view(), true);
   forces.flush(sim);
   forces.close();
@@ -416,6 +425,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   j["wall_seconds"] = wall_s;
   j["solver_seconds"] = loop_s;
   j["segments"] = segments;  // > 1: resumed from checkpoints; the seconds are summed over them
+  j["checkpoint_seconds"] = checkpoint_s;  // in wall_seconds, not in solver_seconds
   j["particle_steps_per_second"] = loop_s > 0.0 ? psteps / loop_s : 0.0;
   j["threads"] = scene.solver.threads > 0 ? scene.solver.threads : tbb::info::default_concurrency();
   j["peak_resident_bytes"] = peak_resident_bytes();

@@ -109,6 +109,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     std::tie(s.lo_m, s.hi_m) = shape_bounds_m(b.shape);
     bodies_.push_back(s);
   }
+  // plastic strain and its rate are kept only when a stored field needs them
+  for (const auto& f : scene_.outputs.fields) track_plastic_ |= f == "strain_rate" || f == "plastic_strain";
   seed_beds();
   if (scene_.solver.contact == ContactMethod::CellFraction) sample_body_fields();
 
@@ -128,8 +130,6 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     case ShapeFunction::Quadratic: pick(QuadraticKernel{}); break;
     case ShapeFunction::Cubic: pick(CubicKernel{}); break;
   }
-  // plastic strain and its rate are kept only when a stored field needs them
-  for (const auto& f : scene_.outputs.fields) track_plastic_ |= f == "strain_rate" || f == "plastic_strain";
   auto pick_law = [&](auto rate) {
     constexpr bool R = decltype(rate)::value;
     if (dilatancy_)
@@ -141,10 +141,6 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   };
   if (scene_.effects.rate_dependence) pick_law(std::true_type{});
   else pick_law(std::false_type{});
-  if (!track_plastic_) {  // freed, not only emptied (`= {}` kept their storage)
-    std::vector<double>().swap(p_.plastic_strain);
-    std::vector<rate_t>().swap(p_.strain_rate);
-  }
   const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
   arena_ = std::make_unique<tbb::task_arena>(threads);
   reorder_particles();
@@ -202,8 +198,10 @@ void Simulation::seed_beds() {
   }
   const size_t n = p_.x.size();
   for (auto* a : {&p_.c00, &p_.c01, &p_.c10, &p_.c11}) a->assign(n, 0.0);
-  p_.plastic_strain.assign(n, 0.0);
-  p_.strain_rate.assign(n, 0.0);
+  if (track_plastic_) {
+    p_.plastic_strain.assign(n, 0.0);
+    p_.strain_rate.assign(n, 0.0);
+  }
   // push_back left up to twice the points' storage (12% at 1.84M points); the reorder's swaps
   // would carry that slack along for the whole run
   p_.for_each_array([](const char*, auto& a) { a.shrink_to_fit(); });
