@@ -52,6 +52,7 @@ std::optional<Calibration> load_calibration(std::string* why) {
     c.cpu = j.value("cpu", "");
     c.date = j.value("date", "");
     c.particles = j.value("particles", size_t(0));
+    c.size_exponent = j.value("size_exponent", 0.0);
     for (const auto& e : j.at("entries"))
       c.entries.push_back({e.at("shape_function").get<std::string>(), e.at("model").get<std::string>(),
                            e.at("threads").get<int>(), e.at("particle_steps_per_s").get<double>()});
@@ -68,6 +69,7 @@ void save_calibration(const Calibration& c) {
   j["cpu"] = c.cpu;
   j["date"] = c.date;
   j["particles"] = c.particles;
+  j["size_exponent"] = c.size_exponent;
   j["units"] = "particle_steps_per_s: particles times solver steps per wall second";
   j["entries"] = nlohmann::json::array();
   for (const auto& e : c.entries)
@@ -108,11 +110,17 @@ double predict_run_wall_s(const Calibration& c, const Scene& scene, std::string*
       }
   }
   const double psteps = estimate_particle_steps(scene);
+  // smaller beds are not scaled up: below the bench size threading overheads, not caches, decide
+  const double particles = double(estimate_particle_count(scene));
+  if (c.particles > 0 && particles > double(c.particles))
+    rate *= std::pow(particles / double(c.particles), std::clamp(c.size_exponent, -0.5, 0.0));
   if (how) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "%d thread%s, %s %s at %.3g M particle-steps/s", threads, threads == 1 ? "" : "s",
                   shape.c_str(), model.c_str(), rate / 1e6);
     *how = buf;
+    if (c.particles > 0 && particles > double(c.particles) && c.size_exponent < 0.0)
+      *how += " for this bed's size";
   }
   return psteps / rate;
 }

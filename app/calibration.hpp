@@ -19,6 +19,10 @@ struct CalibrationEntry {
 struct Calibration {
   std::string host, cpu, date;
   size_t particles = 0;        // size of the bench scene
+  // Larger beds run slower (their particle and grid arrays leave the caches): the rate falls as
+  // (N / particles)^size_exponent, measured between the bench scene and one 16 times larger
+  // (quadratic NDPM, all threads). 0 when not measured (calibrations before 2026-12-01).
+  double size_exponent = 0.0;
   std::vector<CalibrationEntry> entries;
   std::string path;            // where it was read from / is written to
 };
@@ -36,7 +40,7 @@ int run_threads(const Scene& scene);
 
 // Predicted solver wall time of a whole run of `scene` (s): estimated particle-steps over the
 // calibrated rate for its shape function, model and threads (interpolated in threads between the
-// measured counts). NaN when the calibration has no figure for it; *how says what was used.
+// measured counts), scaled to the scene's bed by the size exponent (beds larger than the bench's only). NaN when the calibration has no figure for it; *how says what was used.
 double predict_run_wall_s(const Calibration& c, const Scene& scene, std::string* how = nullptr);
 
 // One line for people: "~1 h 50 min on this machine (2 threads)" or how to get a calibration.

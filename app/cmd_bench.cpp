@@ -32,12 +32,14 @@ std::string cpu_model() {
 
 // The single-plate paper case at dx 5 mm (about 115k particles, between the preview and the paper's
 // resolution), the plate already 20 mm into the bed so contact and plastic flow are part of the cost.
-Scene bench_scene(ShapeFunction shape, bool dpm, int threads) {
+Scene bench_scene(ShapeFunction shape, bool dpm, int threads, double dx_m = 0.005) {
   Scene s = parse_scene_text(find_scene_template("plate_intrusion")->text, "<template plate_intrusion>");
-  s.domain.dx_m = 0.005;
+  s.domain.dx_m = dx_m;
   s.solver.shape_function = shape;
   s.solver.threads = threads;
-  s.outputs.fields.clear();
+  // the template's fields stay listed: its strain-rate output makes the constitutive update keep
+  // the plastic strain and its rate (as every intrusion template does; ~7% of a step at 1.84M
+  // points), but no frame is written
   s.outputs.movies.clear();
   s.outputs.frame_interval_s = 0.0;
   s.bodies[0].start_m.y() -= 0.025;
@@ -49,6 +51,29 @@ Scene bench_scene(ShapeFunction shape, bool dpm, int threads) {
     s.effects.dilatancy = true;
   }
   return s;
+}
+
+// Particle-steps per wall second over at least `seconds` and 20 steps, after 10 steps of warm-up;
+// *phases: the phase seconds of the measured steps.
+double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases) {
+  for (int i = 0; i < 10; ++i) sim.step();  // first touches of memory and contact warm-up
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const PhaseSeconds before = sim.phase_seconds();
+  int64_t steps = 0;
+  double elapsed = 0.0;
+  while (steps < 20 || elapsed < seconds) {
+    sim.step();
+    ++steps;
+    elapsed = std::chrono::duration<double>(clock::now() - t0).count();
+  }
+  if (phases) {
+    const PhaseSeconds& ph = sim.phase_seconds();
+    *phases = {ph.sort - before.sort,       ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
+               ph.g2p - before.g2p,         ph.constitutive - before.constitutive,
+               ph.reorder - before.reorder, ph.g2p_constitutive - before.g2p_constitutive};
+  }
+  return double(steps) * double(sim.particles().size()) / elapsed;
 }
 
 int bench_main(const Parsed& p) {
@@ -73,6 +98,7 @@ int bench_main(const Parsed& p) {
   c.date = date;
 
   const bool quiet = p.has("--quiet");
+  double reference_rate = 0.0;  // quadratic NDPM on all threads at the bench size
   if (!quiet)
     std::fprintf(stderr, "furrow bench: %s, %d core%s; %.3g s per measurement\n", c.cpu.c_str(), cores,
                  cores == 1 ? "" : "s", seconds);
@@ -85,30 +111,27 @@ int bench_main(const Parsed& p) {
       for (int threads : thread_counts) {
         Simulation sim(bench_scene(shape, dpm, threads));
         c.particles = sim.particles().size();
-        for (int i = 0; i < 10; ++i) sim.step();  // first touches of memory and contact warm-up
-        using clock = std::chrono::steady_clock;
-        const auto t0 = clock::now();
-        const PhaseSeconds before = sim.phase_seconds();
-        int64_t steps = 0;
-        double elapsed = 0.0;
-        while (steps < 20 || elapsed < seconds) {
-          sim.step();
-          ++steps;
-          elapsed = std::chrono::duration<double>(clock::now() - t0).count();
-        }
-        const double rate = double(steps) * double(sim.particles().size()) / elapsed;
+        PhaseSeconds ph;
+        const double rate = measure_rate(sim, seconds, &ph);
         c.entries.push_back({shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate});
-        const PhaseSeconds& ph = sim.phase_seconds();
-        const double step_s = ph.total() - before.total();
-        auto share = [&](double now, double then) { return 100.0 * (now - then) / step_s; };
-        const double g2p_now = ph.g2p + ph.constitutive + ph.g2p_constitutive;
-        const double g2p_then = before.g2p + before.constitutive + before.g2p_constitutive;
+        if (shape == ShapeFunction::Quadratic && !dpm && threads == thread_counts.back()) reference_rate = rate;
+        auto share = [&](double phase) { return 100.0 * phase / ph.total(); };
         std::printf("%-10s %-5s %7d %19.2f   %21s %5.1f %5.1f %5.1f %7.1f %9.1f %7.1f\n", shape_names[int(shape)],
-                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.sort, before.sort), share(ph.p2g, before.p2g),
-                    share(ph.grid, before.grid), share(ph.contact, before.contact), share(g2p_now, g2p_then),
-                    share(ph.reorder, before.reorder));
+                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.sort), share(ph.p2g), share(ph.grid),
+                    share(ph.contact), share(ph.g2p + ph.constitutive + ph.g2p_constitutive), share(ph.reorder));
         std::fflush(stdout);
       }
+  // the same at the paper's dx 1.25 mm (16 times the points, 1.84M): how the rate falls with the
+  // bed's size. At 4 times the points it had not fallen yet (the state, ~45 MB, still mostly in
+  // cache); at 16 times it had (README, Performance).
+  {
+    Simulation sim(bench_scene(ShapeFunction::Quadratic, false, thread_counts.back(), 0.00125));
+    const double rate = measure_rate(sim, seconds, nullptr);
+    const double ratio = double(sim.particles().size()) / double(c.particles);
+    c.size_exponent = std::min(0.0, std::log(rate / reference_rate) / std::log(ratio));
+    std::printf("%-10s %-5s %7d %19.2f   at %zu particles: rate ~ particles^%.3f above %zu\n", "quadratic", "ndpm",
+                thread_counts.back(), rate / 1e6, sim.particles().size(), c.size_exponent, c.particles);
+  }
   save_calibration(c);
   std::printf("calibration (%zu particles, plate_intrusion at dx 5 mm) saved to %s\n", c.particles, c.path.c_str());
   return 0;
@@ -124,11 +147,12 @@ Command command_bench() {
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
           "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
           "share of a step each phase takes (sort, P2G, grid update, body and wall contact, G2P with\n"
-          "the constitutive update (one pass), particle reorder), and\n"
+          "the constitutive update (one pass), particle reorder); then quadratic NDPM on all cores at\n"
+          "dx 1.25 mm (16 times the points) for how the rate falls on larger beds; and\n"
           "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"
           "else ~/.config/furrow/calibration.json). `furrow validate` then prints a scene's predicted\n"
           "solver time, `furrow run` compares against it, and `furrow study` predicts its first rung.\n"
-          "About 12 x (S + setup) seconds; the machine should be otherwise idle for figures that hold.",
+          "About 13 x (S + setup) seconds (under a minute at the default S); the machine should be otherwise idle for figures that hold.",
           {{"--seconds", true, false, "seconds per measurement (default 2)", "S"},
            {"--out", true, false, "calibration file to write (replaced)", "FILE"},
            {"--quiet", false, false, "no header line on stderr"}},

@@ -69,6 +69,33 @@ TEST_F(BenchCli, PredictionIsParticleStepsOverTheCalibratedRate) {
   EXPECT_NE(wall.find("1 thread"), std::string::npos) << wall;
 }
 
+// A bed larger than the bench's runs at the calibrated rate times (N / bench particles)^size_exponent.
+TEST_F(BenchCli, LargerBedsArePredictedAtTheSizeScaledRate) {
+  nlohmann::json c = {{"host", "test"}, {"cpu", "test"}, {"date", "today"}, {"particles", 100}, {"size_exponent", 0.0},
+                      {"entries",
+                       {{{"shape_function", "quadratic"}, {"model", "ndpm"}, {"threads", 1}, {"particle_steps_per_s", 1e6}}}}};
+  std::ofstream(path("calibration.json")) << c.dump();
+  const auto [psteps, flat] = validate();
+  c["size_exponent"] = -0.2;
+  std::ofstream(path("calibration.json")) << c.dump();
+  const auto [psteps2, scaled] = validate();
+  const auto r = run({"validate", path("tiny.json")});
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(particles  ~([0-9]+))"))) << r.err;
+  const double n = std::stod(m[1]);
+  ASSERT_GT(n, 400.0);  // well above the calibration's 100
+  auto seconds = [](const std::string& wall) {
+    std::smatch s;
+    EXPECT_TRUE(std::regex_search(wall, s, std::regex(R"(~([0-9]+) s)"))) << wall;
+    return std::stod(s[1]);
+  };
+  // validate prints particle-steps to 3 digits and whole seconds rounded up
+  EXPECT_NEAR(seconds(flat), psteps / 1e6, 1.0) << flat;
+  EXPECT_NEAR(seconds(scaled), psteps / (1e6 * std::pow(n / 100.0, -0.2)), 1.0) << scaled;
+  EXPECT_GT(seconds(scaled), seconds(flat) + 1.0) << flat << " / " << scaled;
+  EXPECT_NE(scaled.find("for this bed's size"), std::string::npos) << scaled;
+}
+
 TEST_F(BenchCli, BenchStoresAFigureForEveryShapeFunctionModelAndThreadCount) {
   const auto r = run({"bench", "--seconds", "0.05", "--quiet"});
   ASSERT_EQ(r.status, 0) << r.err;
@@ -81,6 +108,7 @@ TEST_F(BenchCli, BenchStoresAFigureForEveryShapeFunctionModelAndThreadCount) {
   }
   const size_t thread_counts = std::thread::hardware_concurrency() > 1 ? 2 : 1;
   EXPECT_EQ(seen.size(), 3 * 2 * thread_counts);
+  EXPECT_LE(c.at("size_exponent").get<double>(), 0.0);  // measured on a bed 16 times larger
   const auto [psteps, wall] = validate();
   EXPECT_EQ(wall.find("unknown"), std::string::npos) << wall;
   EXPECT_NE(wall.find("on this machine"), std::string::npos) << wall;
