@@ -89,6 +89,8 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   g_.nx = int(std::ceil(d.width_m / d.dx_m - 1e-9));
   g_.ny = int(std::ceil(d.height_m / d.dx_m - 1e-9));
   g_.NX = g_.nx + 1 + 2 * Grid::kPad;
+  if (g_.nx / kStripCells + 3 > 65535)  // the sort keeps each point's strip in 16 bits
+    throw std::invalid_argument("domain too wide: at most 262,000 cells across");
   g_.NY = g_.ny + 1 + 2 * Grid::kPad;
   const size_t nodes = size_t(g_.NX) * g_.NY;
   g_.node.assign(nodes, GridNode{});
@@ -313,10 +315,13 @@ void Simulation::sort_particles() {
   const size_t chunk = (n + kChunks - 1) / kChunks;
   chunk_counts_.assign(kChunks * size_t(strips), 0);  // [chunk][strip]
   const double inv = 1.0 / g_.dx;
+  strip_of_.resize(n);
   tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
     uint32_t* count = &chunk_counts_[c * size_t(strips)];
     for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) {
-      ++count[strip_index(p_.x[i], inv, kStripCells, strips)];
+      const int s = strip_index(p_.x[i], inv, kStripCells, strips);
+      strip_of_[i] = uint16_t(s);
+      ++count[s];
     }
   });
   // exclusive prefix over (strip, chunk): each chunk's first slot within each strip
@@ -336,7 +341,7 @@ void Simulation::sort_particles() {
   tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
     uint32_t* fill = &chunk_counts_[c * size_t(strips)];
     for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i)
-      order_[fill[strip_index(p_.x[i], inv, kStripCells, strips)]++] = uint32_t(i);
+      order_[fill[strip_of_[i]]++] = uint32_t(i);
   });
 }
 
@@ -1140,6 +1145,7 @@ size_t Simulation::state_bytes() const {
   p_.for_each_array([&](const char*, const auto& a) { b += a.capacity() * sizeof(a[0]); });
   b += g_.node.capacity() * sizeof(GridNode);
   b += (order_.capacity() + strip_start_.capacity() + chunk_counts_.capacity()) * sizeof(uint32_t);
+  b += strip_of_.capacity() * sizeof(uint16_t);
   return b;
 }
 

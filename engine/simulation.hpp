@@ -217,6 +217,7 @@ class Simulation {
   // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
   static constexpr int kStripCells = 4;
   std::vector<uint32_t> order_, strip_start_;
+  std::vector<uint16_t> strip_of_;  // each point's strip, found by the sort's count pass for its fill pass
   std::vector<uint32_t> chunk_counts_;
   mutable std::vector<double> rho_g_cache_;
   void (Simulation::*p2g_)() = nullptr;
