@@ -1,7 +1,5 @@
 #include "app/run_dirs.hpp"
 
-#include <signal.h>
-
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -61,7 +59,7 @@ void remove_stale_partials(const fs::path& dir) {
     const auto at = name.rfind(".partial-");
     if (at == std::string::npos) continue;
     const long pid = std::strtol(name.c_str() + at + 9, nullptr, 10);
-    if (pid > 0 && ::kill(pid_t(pid), 0) == 0) continue;  // still running (another sweep or study)
+    if (process_running(pid)) continue;  // still running (another sweep or study)
     fs::remove_all(e.path());
   }
 }

@@ -35,6 +35,8 @@ nlohmann::json result_defining_json(const Scene& scene) {
   return scene_to_json(s);
 }
 
+bool process_running(long pid) { return pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM); }
+
 std::string scene_hash(const Scene& scene) {
   uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis and prime
   for (const unsigned char c : result_defining_json(scene).dump()) h = (h ^ c) * 1099511628211ull;
@@ -166,8 +168,6 @@ nlohmann::json vec_json(const Vec2& v) {
   auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
   return nlohmann::json::array({num(v.x()), num(v.y())});
 }
-
-bool process_running(long pid) { return pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM); }
 
 // The DIR.partial-* holding a checkpoint of this scene (the furthest along), or an empty path.
 fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene) {

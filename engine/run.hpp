@@ -67,6 +67,9 @@ nlohmann::json result_defining_json(const Scene& scene);
 // finished run directory says which scene it completed without reparsing its scene.json.
 std::string scene_hash(const Scene& scene);
 
+// Whether process `pid` exists on this machine (a DIR.partial-PID still being written).
+bool process_running(long pid);
+
 // Peak resident memory of this process (bytes).
 size_t peak_resident_bytes();
 
