@@ -89,17 +89,6 @@ double checkpoint_interval_s(const Parsed& p) {
   return 60.0 * minutes;
 }
 
-// A checkpoint another run of DIR left behind, so a run that starts afresh says it could resume.
-std::string checkpoint_left(const fs::path& out_dir) {
-  const fs::path dir = fs::absolute(out_dir).lexically_normal();
-  const std::string prefix = dir.filename().string() + ".partial-";
-  if (!fs::is_directory(dir.parent_path())) return "";
-  for (const auto& e : fs::directory_iterator(dir.parent_path()))
-    if (e.path().filename().string().rfind(prefix, 0) == 0 && fs::exists(e.path() / "checkpoint" / "run.json"))
-      return e.path().string();
-  return "";
-}
-
 }  // namespace
 
 static int run_main(const Parsed& p) {
@@ -128,7 +117,7 @@ static int run_main(const Parsed& p) {
     std::fprintf(stderr, "%s: predicted %s of solver time (%s)\n", scene.name.c_str(), format_duration(predicted_s).c_str(),
                  how.c_str());
   if (!opt.resume && !p.has("--quiet"))
-    if (const std::string left = checkpoint_left(opt.out_dir); !left.empty())
+    for (const std::string& left : checkpoint_dirs(opt.out_dir))
       std::fprintf(stderr, "%s holds a checkpoint of a stopped run; this run starts afresh (--resume continues it)\n",
                    left.c_str());
   // SIGINT/SIGTERM (Ctrl-C, a batch system's time limit): checkpoint after the current step and

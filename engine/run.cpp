@@ -5,6 +5,7 @@
 #include <tbb/info.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
@@ -36,6 +37,22 @@ nlohmann::json result_defining_json(const Scene& scene) {
 }
 
 bool process_running(long pid) { return pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM); }
+
+std::vector<std::string> checkpoint_dirs(const std::string& out_dir) {
+  const fs::path final_dir = fs::absolute(out_dir).lexically_normal();
+  const std::string prefix = final_dir.filename().string() + ".partial-";
+  std::vector<std::string> found;
+  if (!fs::is_directory(final_dir.parent_path())) return found;
+  for (const auto& e : fs::directory_iterator(final_dir.parent_path())) {
+    if (e.path().filename().string().rfind(prefix, 0) != 0) continue;
+    // a crash between the two renames of save_checkpoint leaves only checkpoint.old: still whole
+    if (!fs::exists(e.path() / "checkpoint") && fs::exists(e.path() / "checkpoint.old" / "run.json"))
+      fs::rename(e.path() / "checkpoint.old", e.path() / "checkpoint");
+    if (fs::exists(e.path() / "checkpoint" / "run.json")) found.push_back(e.path().string());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
 
 std::string scene_hash(const Scene& scene) {
   uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis and prime
@@ -174,32 +191,26 @@ fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene) {
   const std::string prefix = final_dir.filename().string() + ".partial-", hash = scene_hash(scene);
   fs::path best;
   int64_t best_steps = -1;
-  if (!fs::is_directory(final_dir.parent_path())) return best;
-  for (const auto& e : fs::directory_iterator(final_dir.parent_path())) {
-    const std::string name = e.path().filename().string();
-    if (name.rfind(prefix, 0) != 0) continue;
-    // a crash between the two renames of save_checkpoint leaves only checkpoint.old: still whole
-    if (!fs::exists(e.path() / "checkpoint") && fs::exists(e.path() / "checkpoint.old" / "run.json"))
-      fs::rename(e.path() / "checkpoint.old", e.path() / "checkpoint");
-    const fs::path state = e.path() / "checkpoint" / "run.json";
-    if (!fs::exists(state)) continue;
-    const long pid = std::strtol(name.c_str() + prefix.size(), nullptr, 10);
+  for (const std::string& d : checkpoint_dirs(final_dir.string())) {
+    const fs::path dir(d);
+    const fs::path state = dir / "checkpoint" / "run.json";
+    const long pid = std::strtol(dir.filename().string().c_str() + prefix.size(), nullptr, 10);
     if (pid != long(getpid()) && process_running(pid))
-      throw std::runtime_error(e.path().string() + " is still being written by process " + std::to_string(pid) +
+      throw std::runtime_error(dir.string() + " is still being written by process " + std::to_string(pid) +
                                ": stop it first or choose another --out");
     std::ifstream in(state);
     nlohmann::json j;
     try {
       j = nlohmann::json::parse(in);
     } catch (const std::exception& x) {
-      throw std::runtime_error(state.string() + ": cannot be read (" + x.what() + "); remove " + e.path().string() +
+      throw std::runtime_error(state.string() + ": cannot be read (" + x.what() + "); remove " + dir.string() +
                                " to start afresh");
     }
     if (j.value("scene_hash", std::string()) != hash)
-      throw std::runtime_error(e.path().string() + " holds a checkpoint of a different scene (scene_hash " +
+      throw std::runtime_error(dir.string() + " holds a checkpoint of a different scene (scene_hash " +
                                j.value("scene_hash", std::string("?")) + ", this scene " + hash +
                                "): remove it or choose another --out");
-    if (j.value("steps", int64_t(-1)) > best_steps) best = e.path(), best_steps = j.value("steps", int64_t(-1));
+    if (j.value("steps", int64_t(-1)) > best_steps) best = dir, best_steps = j.value("steps", int64_t(-1));
   }
   return best;
 }

@@ -6,6 +6,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "engine/scene.hpp"
 
@@ -66,6 +67,9 @@ nlohmann::json result_defining_json(const Scene& scene);
 // FNV-1a 64 of result_defining_json(scene).dump() as 16 hex digits; run.json's "scene_hash", so a
 // finished run directory says which scene it completed without reparsing its scene.json.
 std::string scene_hash(const Scene& scene);
+
+// The DIR.partial-* directories that hold a run checkpoint (stopped or killed runs of out_dir).
+std::vector<std::string> checkpoint_dirs(const std::string& out_dir);
 
 // Whether process `pid` exists on this machine (a DIR.partial-PID still being written).
 bool process_running(long pid);
