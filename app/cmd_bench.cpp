@@ -122,8 +122,7 @@ int bench_main(const Parsed& p) {
         std::fflush(stdout);
       }
   // the same at the paper's dx 1.25 mm (16 times the points, 1.84M): how the rate falls with the
-  // bed's size. At 4 times the points it had not fallen yet (the state, ~45 MB, still mostly in
-  // cache); at 16 times it had (README, Performance).
+  // bed's size (at 4 times the points it had not fallen measurably; README, Performance)
   {
     Simulation sim(bench_scene(ShapeFunction::Quadratic, false, thread_counts.back(), 0.00125));
     const double rate = measure_rate(sim, seconds, nullptr);
@@ -152,7 +151,8 @@ Command command_bench() {
           "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"
           "else ~/.config/furrow/calibration.json). `furrow validate` then prints a scene's predicted\n"
           "solver time, `furrow run` compares against it, and `furrow study` predicts its first rung.\n"
-          "About 13 x (S + setup) seconds (under a minute at the default S); the machine should be otherwise idle for figures that hold.",
+          "About 13 x (S + setup) seconds (under a minute at the default S); the machine should be\n"
+          "otherwise idle for figures that hold.",
           {{"--seconds", true, false, "seconds per measurement (default 2)", "S"},
            {"--out", true, false, "calibration file to write (replaced)", "FILE"},
            {"--quiet", false, false, "no header line on stderr"}},
