@@ -23,7 +23,7 @@ ProgressPrinter::ProgressPrinter(std::string label, bool quiet)
 
 void ProgressPrinter::operator()(const RunProgress& p) {
   if (quiet_) return;
-  const double rate = p.wall_s > 0 ? double(p.particles) * double(p.steps) / p.wall_s / 1e6 : 0.0;
+  const double rate = p.particle_steps_per_s / 1e6;
   if (tty_) {
     constexpr int width = 30;
     const int filled = int(p.fraction * width);

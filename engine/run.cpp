@@ -298,6 +298,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   double checkpoint_s = 0.0;  // writing checkpoints, all segments: not solver time
   int segments = 1;
   const double fraction0 = fraction();
+  clock::time_point loop0;  // the solver loop's start in this segment
+  int64_t steps0 = 0;       // and the step it started from
   auto last_report = clock::now();
   auto report = [&](bool force_report) {
     if (!opt.progress) return;
@@ -313,6 +315,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     p.eta_s = p.fraction - fraction0 > 0.01 ? segment_s * (1.0 - p.fraction) / (p.fraction - fraction0) : -1.0;
     p.particles = sim.particles().size();
     p.dt_s = sim.last_dt_s();
+    const double loop_s = std::chrono::duration<double>(now - loop0).count();
+    p.particle_steps_per_s = loop_s > 0.0 ? double(p.particles) * double(p.steps - steps0) / loop_s : 0.0;
     opt.progress(p);
   };
 
@@ -341,7 +345,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     if (frames_on) write_frame();
     if (collapse.active()) collapse.add_step(0.0, sim.particle_view());
   }
-  const auto loop0 = clock::now();
+  loop0 = clock::now();
+  steps0 = sim.step_count();
   // The run's state after a step, written beside the old checkpoint and swapped in by two renames
   // (find_checkpoint takes checkpoint.old if a crash falls between them).
   double segment_checkpoint_s = 0.0;

@@ -20,6 +20,7 @@ struct RunProgress {
   double eta_s = 0.0;     // < 0 while unknown
   size_t particles = 0;
   double dt_s = 0.0;
+  double particle_steps_per_s = 0.0;  // the solver loop's rate in this segment (start-up aside)
 };
 
 struct RunOptions {
