@@ -103,7 +103,8 @@ static int run_main(const Parsed& p) {
   opt.out_dir = p.get("--out", (fs::path("out") / scene.name).string());
   opt.force = p.has("--force");
   opt.write_paraview = !p.has("--no-paraview");
-  opt.resume = p.has("--resume");
+  opt.resume = p.has("--resume") || p.has("--resume-any-build");
+  opt.resume_any_build = p.has("--resume-any-build");
   opt.checkpoint_interval_s = checkpoint_interval_s(p);
   if (fs::exists(opt.out_dir) && !opt.force) {
     std::cerr << "furrow run: " << opt.out_dir
@@ -192,12 +193,15 @@ Command command_run() {
             "system's time limit), the run's whole state goes to DIR.partial-PID/checkpoint; a signal then\n"
             "stops the run with exit status 130. The same command with --resume continues from there with\n"
             "results identical to an uninterrupted run (any thread count); run.json's wall and solver\n"
-            "seconds are summed over the segments.",
+            "seconds are summed over the segments. A checkpoint is resumed only by the build that wrote\n"
+            "it (run.json \"build\": version and executable hash) unless --resume-any-build is given.",
             {{"--out", true, false, "run directory (default out/<scene name>)", "DIR"},
              {"--force", false, false, "replace an existing run directory once the new run completes"},
              {"--no-movies", false, false, "skip rendering movies"},
              {"--no-paraview", false, false, "skip the ParaView .vti/.pvd files"},
              {"--resume", false, false, "continue a stopped run of this scene from its checkpoint (none: start afresh)"},
+             {"--resume-any-build", false, false,
+              "--resume, also from a checkpoint another build wrote (run.json then lists the builds)"},
              {"--checkpoint-every", true, false, "minutes of wall time between checkpoints (default 30; 0: only on a signal)",
               "MIN"}},
             1, 1, run_main};

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "engine/analysis.hpp"
@@ -54,12 +55,27 @@ std::vector<std::string> checkpoint_dirs(const std::string& out_dir) {
   return found;
 }
 
-std::string scene_hash(const Scene& scene) {
+namespace {
+// FNV-1a 64 of bytes as 16 hex digits
+std::string fnv1a_hex(const std::string& bytes) {
   uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis and prime
-  for (const unsigned char c : result_defining_json(scene).dump()) h = (h ^ c) * 1099511628211ull;
+  for (const unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return hex;
+}
+}  // namespace
+
+std::string scene_hash(const Scene& scene) { return fnv1a_hex(result_defining_json(scene).dump()); }
+
+const std::string& build_id() {
+  static const std::string id = [] {
+    std::ifstream in("/proc/self/exe", std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return std::string(FURROW_VERSION) + "-" + (in ? fnv1a_hex(bytes.str()) : std::string("unknown"));
+  }();
+  return id;
 }
 
 namespace {
@@ -187,7 +203,7 @@ nlohmann::json vec_json(const Vec2& v) {
 }
 
 // The DIR.partial-* holding a checkpoint of this scene (the furthest along), or an empty path.
-fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene) {
+fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene, bool any_build) {
   const std::string prefix = final_dir.filename().string() + ".partial-", hash = scene_hash(scene);
   fs::path best;
   int64_t best_steps = -1;
@@ -210,6 +226,12 @@ fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene) {
       throw std::runtime_error(dir.string() + " holds a checkpoint of a different scene (scene_hash " +
                                j.value("scene_hash", std::string("?")) + ", this scene " + hash +
                                "): remove it or choose another --out");
+    // checkpoints from before builds were recorded carry none: taken as this build's
+    const std::string build = j.value("build", build_id());
+    if (build != build_id() && !any_build)
+      throw std::runtime_error(dir.string() + " holds a checkpoint written by build " + build + ", this program is " +
+                               build_id() + ": resumed by it, the run would not be bit-identical to an uninterrupted "
+                               "one. Continue it with that build, or pass --resume-any-build");
     if (j.value("steps", int64_t(-1)) > best_steps) best = dir, best_steps = j.value("steps", int64_t(-1));
   }
   return best;
@@ -227,7 +249,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   const fs::path checkpoint_dir = tmp_dir / "checkpoint";
   nlohmann::json resumed;  // the checkpoint's run state; null for a new run
   if (opt.resume) {
-    const fs::path from = find_checkpoint(final_dir, scene);
+    const fs::path from = find_checkpoint(final_dir, scene, opt.resume_any_build);
     if (!from.empty()) {
       if (from != tmp_dir) {
         fs::remove_all(tmp_dir);
@@ -324,6 +346,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   int contact_sweeps_max = 0;
   double contact_residual_max = 0.0;
   RunSummary summary;
+  nlohmann::json builds = nlohmann::json::array();  // every build that ran a segment, in order
+  if (!resumed.is_null()) builds = resumed.value("builds", nlohmann::json::array({resumed.value("build", build_id())}));
+  if (builds.empty() || builds.back() != build_id()) builds.push_back(build_id());
   if (!resumed.is_null()) {
     summary.resumed_from_step = sim.step_count();
     const auto& r = resumed;
@@ -363,15 +388,19 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     }
     nlohmann::json pvd_json = nlohmann::json::array();
     for (const auto& e : pvd) pvd_json.push_back({e.time_s, e.file});
+    // the state file is the checkpoint's cost; its small run.json is left out
+    const double writing_s = std::chrono::duration<double>(clock::now() - t0).count();
     const nlohmann::json j = {
-        {"scene_hash", scene_hash(scene)}, {"steps", sim.step_count()}, {"time_s", sim.time_s()},
+        {"scene_hash", scene_hash(scene)}, {"build", build_id()}, {"builds", builds},
+        {"steps", sim.step_count()}, {"time_s", sim.time_s()},
         {"frame_index", frame_index}, {"next_frame_s", next_frame_s}, {"pvd", pvd_json},
         {"dt_min_s", dt_min}, {"dt_max_s", dt_max},
         {"contact", {contact_sweeps, contact_unconverged, contact_points_max, contact_sweeps_max, contact_residual_max}},
         {"wall_seconds", wall_before_s + std::chrono::duration<double>(clock::now() - wall0).count()},
         {"solver_seconds",
          solver_before_s + std::chrono::duration<double>(t0 - loop0).count() - segment_checkpoint_s},
-        {"segments", segments}, {"checkpoint_seconds", checkpoint_s}, {"forces", forces.state()}, {"stats", stats.state()},
+        {"segments", segments}, {"checkpoint_seconds", checkpoint_s + writing_s}, {"forces", forces.state()},
+        {"stats", stats.state()},
         {"analysis", analysis.state()}, {"collapse", collapse.state()}};
     write_file_atomic((fresh / "run.json").string(), j.dump() + "\n");
     fs::remove_all(old);
@@ -442,6 +471,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   j["solver_seconds"] = loop_s;
   j["segments"] = segments;  // > 1: resumed from checkpoints; the seconds are summed over them
   j["checkpoint_seconds"] = checkpoint_s;  // in wall_seconds, not in solver_seconds
+  j["build"] = build_id();
+  if (builds.size() > 1) j["resumed_across_builds"] = builds;  // --resume-any-build: not bit-identical
   j["particle_steps_per_second"] = loop_s > 0.0 ? psteps / loop_s : 0.0;
   j["threads"] = scene.solver.threads > 0 ? scene.solver.threads : tbb::info::default_concurrency();
   j["peak_resident_bytes"] = peak_resident_bytes();

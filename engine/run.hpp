@@ -40,6 +40,9 @@ struct RunOptions {
   double checkpoint_interval_s = 0.0;
   std::function<bool()> stop_requested;
   bool resume = false;
+  // resume a checkpoint another build of Furrow wrote (refused otherwise: the run would not be
+  // bit-identical to an uninterrupted one); run.json then says so ("resumed_across_builds")
+  bool resume_any_build = false;
 };
 
 // Per-body force summary over the scene's averaging window.
@@ -59,7 +62,8 @@ struct RunSummary {
 };
 
 // Throws std::runtime_error when out_dir exists and !force, when an output cannot be written, or
-// (resume) when a DIR.partial-* checkpoint belongs to another scene or a process still running.
+// (resume) when a DIR.partial-* checkpoint belongs to another scene, to a process still running
+// or (without resume_any_build) to another build.
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
 // The resolved scene without what cannot change a run's results (solver.threads: runs are
@@ -74,6 +78,10 @@ std::vector<std::string> checkpoint_dirs(const std::string& out_dir);
 
 // Whether process `pid` exists on this machine (a DIR.partial-PID still being written).
 bool process_running(long pid);
+
+// This program's build: Furrow's version and a hash of the running executable (checkpoints and
+// run.json record it; the same sources built the same way give the same id).
+const std::string& build_id();
 
 // Peak resident memory of this process (bytes).
 size_t peak_resident_bytes();

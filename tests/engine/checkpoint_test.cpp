@@ -118,7 +118,8 @@ INSTANTIATE_TEST_SUITE_P(Contact, Checkpoint,
                          ::testing::Values(ContactMethod::Node, ContactMethod::Particle, ContactMethod::CellFraction),
                          [](const auto& info) { return std::string(contact_method_name(info.param)); });
 
-// A checkpoint is refused, with the file and the item named, when it is not of this scene.
+// A checkpoint is refused, with the file and the item named, when it is not of this scene or
+// (unless asked for) was written by another build.
 TEST(CheckpointErrors, OtherSceneAndDamagedFilesAreNamed) {
   Scene s = checkpoint_scene(ContactMethod::Node);
   s.solver.end_displacement_m = 0.003;
@@ -140,6 +141,34 @@ TEST(CheckpointErrors, OtherSceneAndDamagedFilesAreNamed) {
     EXPECT_NE(std::string(e.what()).find("different scene"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(part.out_dir), std::string::npos) << e.what();
   }
+
+  // a checkpoint another build wrote: refused unless asked for, and then run.json says so
+  const fs::path state_json = fs::path(part.out_dir) / "checkpoint" / "run.json";
+  nlohmann::json cj;
+  {
+    std::ifstream in(state_json);
+    cj = nlohmann::json::parse(in);
+  }
+  EXPECT_EQ(cj.at("build").get<std::string>(), build_id());
+  cj["build"] = "0.0.0-other";
+  cj["builds"] = {"0.0.0-other"};
+  std::ofstream(state_json) << cj.dump();
+  try {
+    run_scene(s, o);
+    ADD_FAILURE() << "a checkpoint of another build was resumed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("0.0.0-other"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--resume-any-build"), std::string::npos) << e.what();
+  }
+  o.resume_any_build = true;
+  const RunSummary across = run_scene(s, o);
+  EXPECT_EQ(across.resumed_from_step, part.run_json.at("steps").get<int64_t>());
+  EXPECT_EQ(across.run_json.at("resumed_across_builds"), nlohmann::json({"0.0.0-other", build_id()}));
+  o.resume_any_build = false;
+  o.force = true;
+  const RunSummary fresh = run_scene(s, o);  // nothing left to resume: a new run, one build
+  EXPECT_EQ(fresh.resumed_from_step, -1);
+  EXPECT_FALSE(fresh.run_json.contains("resumed_across_builds"));
 
   // the simulation state of a scene with more particles
   Simulation sim(s);
