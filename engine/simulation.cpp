@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <immintrin.h>
 #include <cstddef>
 #include <cstring>
 #include <istream>
@@ -840,6 +841,149 @@ void Simulation::front_back_friction() {
   stats_.front_back_impulse_N_s_per_m = impulse;
 }
 
+// The default G2P (quadratic B-splines, FLIP) four points at a time, a point per lane: the
+// weights and everything after the gather (affine matrix, FLIP update, advection, the margins).
+// Only the gather from each point's nine nodes runs a point at a time (4-wide over the node's
+// fields, as in g2p_range). Every point of the range takes this path, a range's last group with
+// its empty lanes filled by its last point, so a point's bits do not depend on how the range
+// was split among threads. Returns `end`, or `begin` to leave the range to g2p_range's loop.
+size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc) {
+#if !defined(__AVX__)
+  return begin;  // _mm256_floor_pd: built without AVX, g2p_range's loop does it all
+#else
+  using V = Vec4d;
+  constexpr size_t kMaxBodies = 8;  // more bodies (rare): g2p_range's loop
+  const size_t nb = bodies_.size();
+  if (nb > kMaxBodies) return begin;
+  const double dx = g_.dx, ih = 1.0 / dx, dt = dt_s_, alpha = scene_.solver.flip_blend;
+  const double sc = QuadraticKernel::inv_D(ih);
+  const size_t NX = size_t(g_.NX);
+  const GridNode* const grid = g_.node.data();
+  // each body's box in world coordinates, a little wider: only a lane inside one goes on to the
+  // safety net's own test
+  double box[kMaxBodies][4];
+  for (size_t b = 0; b < nb; ++b) {
+    const BodyState& s = bodies_[b];
+    const double pad = 1e-6 * dx;
+    box[b][0] = s.position_m.x() + s.lo_m.x() - pad, box[b][1] = s.position_m.y() + s.lo_m.y() - pad;
+    box[b][2] = s.position_m.x() + s.hi_m.x() + pad, box[b][3] = s.position_m.y() + s.hi_m.y() + pad;
+  }
+  const V zero = {0, 0, 0, 0}, lo = zero - dx, hx = zero + (scene_.domain.width_m + dx),
+          hy = zero + (scene_.domain.height_m + dx);
+  auto& P = p_;
+  double *const X = P.x.data(), *const Y = P.y.data(), *const VX = P.vx.data(), *const VY = P.vy.data();
+
+  // count: a std::integral_constant 4 for a full group (compiled apart: no lane tests), a size_t
+  // for the last
+  auto group = [&](const size_t p, const auto count) {
+    auto load = [&](const double* a) {
+      V v;
+      if (count == 4) return std::memcpy(&v, a + p, sizeof v), v;
+      for (size_t l = 0; l < 4; ++l) v[l] = a[p + std::min(l, size_t(count) - 1)];
+      return v;
+    };
+    auto store = [&](auto* a, const V& v) {
+      using T = std::remove_reference_t<decltype(*a)>;
+      if (count < 4) {
+        for (size_t l = 0; l < count; ++l) a[p + l] = T(v[l]);
+      } else if constexpr (std::is_same_v<T, float>) {
+        typedef float V4f __attribute__((vector_size(16)));
+        const V4f f = __builtin_convertvector(v, V4f);
+        std::memcpy(a + p, &f, sizeof f);
+      } else {
+        std::memcpy(a + p, &v, sizeof v);
+      }
+    };
+    const V xp = load(X), yp = load(Y);
+    // QuadraticKernel::weights
+    auto weights = [&](const V& xq, V w[3], int base[4]) {
+      const V xg = xq * ih;
+      const V b = (V)_mm256_floor_pd((__m256d)(xg - 0.5));
+      const V f = xg - b;
+      w[0] = 0.5 * (1.5 - f) * (1.5 - f);
+      w[1] = 0.75 - (f - 1.0) * (f - 1.0);
+      w[2] = 0.5 * (f - 0.5) * (f - 0.5);
+      for (int l = 0; l < 4; ++l) base[l] = int(b[l]);
+      return b;
+    };
+    V wx[3], wy[3], wxd[3], wyd[3];
+    int bx[4], by[4];
+    const V bxd = weights(xp, wx, bx), byd = weights(yp, wy, by);
+    for (int a = 0; a < 3; ++a) {
+      wxd[a] = wx[a] * ((bxd + double(a)) * dx - xp);
+      wyd[a] = wy[a] * ((byd + double(a)) * dx - yp);
+    }
+    // the gather of [vx vy vx0 vy0], as in g2p_range: per row R = sum wx g, S = sum wx dxp g
+    V vel[4], ax[4], ay[4];
+    for (int l = 0; l < 4; ++l) {
+      V vl = zero, axl = zero, ayl = zero;
+      for (int b = 0; b < 3; ++b) {
+        const GridNode* row = grid + Grid::index(bx[l], by[l] + b, NX);
+        V R = zero, S = zero;
+        for (int a = 0; a < 3; ++a) {
+          const V g = four_at(&row[a].vx);
+          R += wx[a][l] * g;
+          S += wxd[a][l] * g;
+        }
+        vl += wy[b][l] * R;
+        axl += wy[b][l] * S;
+        ayl += wyd[b][l] * R;
+      }
+      vel[l] = vl, ax[l] = axl, ay[l] = ayl;
+    }
+    // back to a point per lane
+    const V vx = {vel[0][0], vel[1][0], vel[2][0], vel[3][0]}, vy = {vel[0][1], vel[1][1], vel[2][1], vel[3][1]};
+    const V ox = {vel[0][2], vel[1][2], vel[2][2], vel[3][2]}, oy = {vel[0][3], vel[1][3], vel[2][3], vel[3][3]};
+    store(P.c00.data(), V{ax[0][0], ax[1][0], ax[2][0], ax[3][0]} * sc);
+    store(P.c10.data(), V{ax[0][1], ax[1][1], ax[2][1], ax[3][1]} * sc);
+    store(P.c01.data(), V{ay[0][0], ay[1][0], ay[2][0], ay[3][0]} * sc);
+    store(P.c11.data(), V{ay[0][1], ay[1][1], ay[2][1], ay[3][1]} * sc);
+    V x = xp + dt * vx, y = yp + dt * vy;
+    V ux = vx + alpha * (load(VX) - ox), uy = vy + alpha * (load(VY) - oy);
+    // the safety net (g2p_range's), for the lanes in a body's box
+    for (size_t b = 0; b < nb; ++b) {
+      const auto in = (x >= box[b][0]) & (y >= box[b][1]) & (x <= box[b][2]) & (y <= box[b][3]);
+      for (size_t l = 0; l < count; ++l) {
+        if (!in[l]) continue;
+        const BodyState& s = bodies_[b];
+        Vec2 xl(x[l], y[l]), vl(ux[l], uy[l]);
+        const Vec2 q = xl - s.position_m;
+        if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) continue;
+        const Shape& shape = scene_.bodies[b].shape;
+        const double d = shape_sdf(shape, q);
+        if (d >= 0.0) continue;
+        const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
+        xl -= d * n;
+        const Vec2 v0 = vl;
+        contact(vl, s.velocity_m_s, n, 0.0);
+        loc.impulse[b] += double(P.mass[p + l]) * (vl - v0);
+        ++loc.projected;
+        x[l] = xl.x(), y[l] = xl.y(), ux[l] = vl.x(), uy[l] = vl.y();
+      }
+    }
+    // the grid margin bounds where a point may go (g2p_range's std::max / std::min)
+    auto out = x < lo;
+    x = out ? lo : x, ux = out ? (ux < 0.0 ? zero : ux) : ux;
+    out = x > hx;
+    x = out ? hx : x, ux = out ? (0.0 < ux ? zero : ux) : ux;
+    out = y < lo;
+    y = out ? lo : y, uy = out ? (uy < 0.0 ? zero : uy) : uy;
+    out = y > hy;
+    y = out ? hy : y, uy = out ? (0.0 < uy ? zero : uy) : uy;
+    store(X, x);
+    store(Y, y);
+    store(VX, ux);
+    store(VY, uy);
+    const V speed2 = ux * ux + uy * uy;
+    for (size_t l = 0; l < count; ++l) loc.vmax2 = std::max(loc.vmax2, speed2[l]);
+  };
+  size_t p = begin;
+  for (; p + 4 <= end; p += 4) group(p, std::integral_constant<size_t, 4>());
+  if (p < end) group(p, end - p);
+  return end;
+#endif
+}
+
 template <class K, bool Flip>
 void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_, alpha = scene_.solver.flip_blend;
@@ -847,6 +991,8 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   const double xmax = scene_.domain.width_m, ymax = scene_.domain.height_m;
   const size_t nb = bodies_.size();
   auto& P = p_;
+  if constexpr (std::is_same_v<K, QuadraticKernel> && Flip)
+    if (g2p_by_four_) begin = g2p_quadratic_by_four(begin, end, loc);
   for (size_t p = begin; p < end; ++p) {
     double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
     const double xp = P.x[p], yp = P.y[p];
