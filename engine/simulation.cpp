@@ -55,6 +55,21 @@ typedef double Vec4dU __attribute__((vector_size(32), aligned(8)));
 inline Vec4dU& four_at(double* first) { return *reinterpret_cast<Vec4dU*>(first); }
 inline const Vec4dU& four_at(const double* first) { return *reinterpret_cast<const Vec4dU*>(first); }
 
+#if defined(__AVX__)
+// QuadraticKernel::weights for four points, a point per lane (the same arithmetic, the same bits);
+// returns the first node's index as doubles and fills `base` with it as ints
+inline Vec4d quadratic_weights_by_four(const Vec4d& x_m, double inv_dx, Vec4d w[3], int base[4]) {
+  const Vec4d xg = x_m * inv_dx;
+  const Vec4d b = (Vec4d)_mm256_floor_pd((__m256d)(xg - 0.5));
+  const Vec4d f = xg - b;
+  w[0] = 0.5 * (1.5 - f) * (1.5 - f);
+  w[1] = 0.75 - (f - 1.0) * (f - 1.0);
+  w[2] = 0.5 * (f - 0.5) * (f - 0.5);
+  for (int l = 0; l < 4; ++l) base[l] = int(b[l]);
+  return b;
+}
+#endif
+
 // The P2G strip of `cells` cell columns holding x; strip 0 and the last take the grid margins.
 inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
   return std::clamp(int(std::floor(x_m * inv_dx)) / cells + 1, 0, strips - 1);
@@ -443,8 +458,76 @@ void Simulation::particles_to_grid() {
     }
   };
   const int strips = int(strip_start_.size()) - 1;
+#if defined(__AVX__)
+  if constexpr (std::is_same_v<K, QuadraticKernel> && Flip) {
+    if (transfers_by_four_) {
+      for (int colour = 0; colour < 2; ++colour)
+        tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) { p2g_strip_quadratic_by_four(2 * k + colour); });
+      return;
+    }
+  }
+#endif
   for (int colour = 0; colour < 2; ++colour)
     tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) { scatter_strip(2 * k + colour); });
+}
+
+// The default P2G (quadratic B-splines, FLIP) of one strip, four points at a time: a point per
+// lane for its weights, stress and affine terms and the per-column factors of scatter_strip's
+// default path; the scatter itself stays a point at a time, in the strip's order (the same sums
+// in the same order: the same bits as scatter_strip, tested).
+void Simulation::p2g_strip_quadratic_by_four(int strip) {
+#if defined(__AVX__)
+  using V = Vec4d;
+  const double h = g_.dx, ih = 1.0 / h, dt = dt_s_, Dinv = QuadraticKernel::inv_D(ih);
+  GridNode* const nodes = g_.node.data();
+  const size_t NX = size_t(g_.NX);
+  const uint32_t* const order = order_.data();
+  const Particles& P = p_;
+  const uint32_t k0 = strip_start_[size_t(strip)], k1 = strip_start_[size_t(strip) + 1];
+  for (uint32_t k = k0; k < k1; k += 4) {
+    // a strip's last group fills its empty lanes with its last point and scatters only the real ones
+    const uint32_t count = std::min<uint32_t>(4, k1 - k);
+    uint32_t idx[4];
+    for (uint32_t l = 0; l < 4; ++l) idx[l] = order[k + std::min(l, count - 1)];
+    auto gather = [&](const auto& a) { return V{double(a[idx[0]]), double(a[idx[1]]), double(a[idx[2]]), double(a[idx[3]])}; };
+    const V xp = gather(P.x), yp = gather(P.y);
+    V wx[3], wy[3];
+    int bx[4], by[4];
+    const V bxd = quadratic_weights_by_four(xp, ih, wx, bx), byd = quadratic_weights_by_four(yp, ih, wy, by);
+    const V m = gather(P.mass), vol = gather(P.volume), pressure = gather(P.pressure);
+    const V sxx = gather(P.sxx) - pressure, syy = gather(P.syy) - pressure, sxy = gather(P.sxy);
+    const V mvx = m * gather(P.vx), mvy = m * gather(P.vy);
+    const V ks = -dt * vol * Dinv;
+    const V s00 = ks * sxx, s01 = ks * sxy, s11 = ks * syy;
+    const V q00 = m * gather(P.c00), q01 = m * gather(P.c01), q10 = m * gather(P.c10), q11 = m * gather(P.c11);
+    const V dx0 = bxd * h - xp, dy0 = byd * h - yp;
+    V dxp[3], u[3], v[3], wdy[3];
+    for (int a = 0; a < 3; ++a) {
+      dxp[a] = dx0 + a * h;
+      u[a] = wx[a] * dxp[a] * s01;
+      v[a] = wx[a] * s11;
+      wdy[a] = wy[a] * (dy0 + a * h);
+    }
+    for (uint32_t l = 0; l < count; ++l) {
+      const V base = {m[l], mvx[l], mvy[l], 0.0}, colA = {0.0, q00[l], q10[l], s00[l]}, colB = {0.0, q01[l], q11[l], s01[l]};
+      V Ua[3], Va[3];
+      for (int a = 0; a < 3; ++a) {
+        Ua[a] = wx[a][l] * (base + dxp[a][l] * colA);
+        Va[a] = wx[a][l] * colB;
+      }
+      for (int b = 0; b < 3; ++b) {
+        GridNode* const row = nodes + Grid::index(bx[l], by[l] + b, NX);
+        const double wb = wy[b][l], wdb = wdy[b][l];
+        for (int a = 0; a < 3; ++a) {
+          four_at(&row[a].m) += wb * Ua[a] + wdb * Va[a];
+          row[a].vy0 += wb * u[a][l] + wdb * v[a][l];
+        }
+      }
+    }
+  }
+#else
+  (void)strip;
+#endif
 }
 
 void Simulation::grid_update() {
@@ -895,20 +978,9 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
       }
     };
     const V xp = load(X), yp = load(Y);
-    // QuadraticKernel::weights
-    auto weights = [&](const V& xq, V w[3], int base[4]) {
-      const V xg = xq * ih;
-      const V b = (V)_mm256_floor_pd((__m256d)(xg - 0.5));
-      const V f = xg - b;
-      w[0] = 0.5 * (1.5 - f) * (1.5 - f);
-      w[1] = 0.75 - (f - 1.0) * (f - 1.0);
-      w[2] = 0.5 * (f - 0.5) * (f - 0.5);
-      for (int l = 0; l < 4; ++l) base[l] = int(b[l]);
-      return b;
-    };
     V wx[3], wy[3], wxd[3], wyd[3];
     int bx[4], by[4];
-    const V bxd = weights(xp, wx, bx), byd = weights(yp, wy, by);
+    const V bxd = quadratic_weights_by_four(xp, ih, wx, bx), byd = quadratic_weights_by_four(yp, ih, wy, by);
     for (int a = 0; a < 3; ++a) {
       wxd[a] = wx[a] * ((bxd + double(a)) * dx - xp);
       wyd[a] = wy[a] * ((byd + double(a)) * dx - yp);
@@ -992,7 +1064,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   const size_t nb = bodies_.size();
   auto& P = p_;
   if constexpr (std::is_same_v<K, QuadraticKernel> && Flip)
-    if (g2p_by_four_) begin = g2p_quadratic_by_four(begin, end, loc);
+    if (transfers_by_four_) begin = g2p_quadratic_by_four(begin, end, loc);
   for (size_t p = begin; p < end; ++p) {
     double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
     const double xp = P.x[p], yp = P.y[p];

@@ -121,16 +121,16 @@ TEST(Mpm, OneAndTwoThreadsGiveIdenticalResults) {
 // G2P and the constitutive update fused into one pass over each block of particles (the default)
 // do the same arithmetic as two passes, so every bit agrees; DPM with plastic strain tracked takes
 // the most state through the fused pass.
-// The default G2P runs four points at a time (a point per SIMD lane) and must give what the point
-// by point loop gives, bit for bit: ranges that do not divide by four, points the safety net puts
-// back on the plate's surface, and the points' margins included.
-TEST(Mpm, FourWideG2PGivesTheSameBitsAsThePointByPointLoop) {
+// The default P2G and G2P run four points at a time (a point per SIMD lane) and must give what the
+// point by point loops give, bit for bit: strips and ranges that do not divide by four, points
+// the safety net puts back on the plate's surface, and the points' margins included.
+TEST(Mpm, FourWideTransfersGiveTheSameBitsAsThePointByPointLoops) {
   Scene s = bed_scene(test_scenes::glass_beads(), 0.205, 0.105, 0.03, 0.005, 1.0, 0.58);  // 41 x 21 cells
   s.bodies.push_back(plate(0.04, 0.01, 0.1, 0.095, Vec2(0.3, -0.6)));  // fast and sunk: the net acts
   s.solver.particles_per_cell_1d = 3;  // 9 a cell: a point count that does not divide by four
   s.solver.threads = 2;
   Simulation four(s), one(s);
-  one.set_g2p_by_four(false);
+  one.set_transfers_by_four(false);
   int64_t projected = 0;
   for (int k = 0; k < 300; ++k) {
     four.step();
