@@ -569,6 +569,22 @@ inline bool contact(Vec2& v, const Vec2& vb, const Vec2& n, double mu) {
   return true;
 }
 
+// G2P's safety net: a point that still ended inside the body is put back on its surface, and the
+// impulse that removes its approach velocity counts in the body's force. Whether it acted.
+inline bool put_back_on_surface(const BodyState& s, const Shape& shape, double dx, double mass, Vec2& x, Vec2& v,
+                                Vec2& impulse) {
+  const Vec2 q = x - s.position_m;
+  if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) return false;
+  const double d = shape_sdf(shape, q);
+  if (d >= 0.0) return false;
+  const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
+  x -= d * n;
+  const Vec2 v0 = v;
+  contact(v, s.velocity_m_s, n, 0.0);
+  impulse += mass * (v - v0);
+  return true;
+}
+
 }  // namespace
 
 void Simulation::bodies_and_walls() {
@@ -1017,18 +1033,9 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
       const auto in = (x >= box[b][0]) & (y >= box[b][1]) & (x <= box[b][2]) & (y <= box[b][3]);
       for (size_t l = 0; l < count; ++l) {
         if (!in[l]) continue;
-        const BodyState& s = bodies_[b];
         Vec2 xl(x[l], y[l]), vl(ux[l], uy[l]);
-        const Vec2 q = xl - s.position_m;
-        if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) continue;
-        const Shape& shape = scene_.bodies[b].shape;
-        const double d = shape_sdf(shape, q);
-        if (d >= 0.0) continue;
-        const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
-        xl -= d * n;
-        const Vec2 v0 = vl;
-        contact(vl, s.velocity_m_s, n, 0.0);
-        loc.impulse[b] += double(P.mass[p + l]) * (vl - v0);
+        if (!put_back_on_surface(bodies_[b], scene_.bodies[b].shape, dx, double(P.mass[p + l]), xl, vl, loc.impulse[b]))
+          continue;
         ++loc.projected;
         x[l] = xl.x(), y[l] = xl.y(), ux[l] = vl.x(), uy[l] = vl.y();
       }
@@ -1132,22 +1139,10 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
     // positions move with the grid velocity; FLIP keeps part of the particle's own velocity
     Vec2 x(xp + dt * vx, yp + dt * vy), v(vx, vy);
     if constexpr (Flip) v += alpha * Vec2(P.vx[p] - ox, P.vy[p] - oy);
-    // safety net: a particle that still ended inside a body is put back on its surface; the
-    // impulse that removes its approach velocity counts in the body's force
-    for (size_t b = 0; b < nb; ++b) {
-      const BodyState& s = bodies_[b];
-      const Vec2 q = x - s.position_m;
-      if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) continue;
-      const Shape& shape = scene_.bodies[b].shape;
-      const double d = shape_sdf(shape, q);
-      if (d >= 0.0) continue;
-      const Vec2 n = shape_normal(shape, q, 1e-4 * dx);
-      x -= d * n;
-      const Vec2 v0 = v;
-      contact(v, s.velocity_m_s, n, 0.0);
-      loc.impulse[b] += double(P.mass[p]) * (v - v0);
-      ++loc.projected;
-    }
+    // the safety net: a particle that still ended inside a body is put back on its surface
+    for (size_t b = 0; b < nb; ++b)
+      if (put_back_on_surface(bodies_[b], scene_.bodies[b].shape, dx, double(P.mass[p]), x, v, loc.impulse[b]))
+        ++loc.projected;
     // the grid margin bounds where a particle may go; walls normally stop it well before
     if (x.x() < -dx) { x.x() = -dx; v.x() = std::max(v.x(), 0.0); }
     if (x.x() > xmax + dx) { x.x() = xmax + dx; v.x() = std::min(v.x(), 0.0); }
