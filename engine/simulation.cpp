@@ -460,7 +460,7 @@ void Simulation::particles_to_grid() {
   const int strips = int(strip_start_.size()) - 1;
 #if defined(__AVX__)
   if constexpr (std::is_same_v<K, QuadraticKernel> && Flip) {
-    if (transfers_by_four_) {
+    if (by_four_) {
       for (int colour = 0; colour < 2; ++colour)
         tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) { p2g_strip_quadratic_by_four(2 * k + colour); });
       return;
@@ -1071,7 +1071,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   const size_t nb = bodies_.size();
   auto& P = p_;
   if constexpr (std::is_same_v<K, QuadraticKernel> && Flip)
-    if (transfers_by_four_) begin = g2p_quadratic_by_four(begin, end, loc);
+    if (by_four_) begin = g2p_quadratic_by_four(begin, end, loc);
   for (size_t p = begin; p < end; ++p) {
     double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
     const double xp = P.x[p], yp = P.y[p];
@@ -1156,8 +1156,115 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   }
 }
 
+// NDPM's update (PlasticityModel<false>::update) four points at a time, a point per lane: the same
+// operations in the same order, the branches as lane selects (the same bits, tested). A group
+// whose points are of different materials, or a lane that needs the library's exp or log (a
+// volume strain of 1e-3 in a step), goes through update() instead. Returns `end`, or where
+// constitutive_range's loop must take over when built without AVX.
+template <bool Track>
+size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
+#if !defined(__AVX__)
+  return begin;
+#else
+  using V = Vec4d;
+  typedef long long M __attribute__((vector_size(32)));  // a lane mask
+  typedef float V4f __attribute__((vector_size(16)));
+  const double dt = dt_s_;
+  auto& P = p_;
+  auto load = [](const auto* a) {
+    using T = std::remove_const_t<std::remove_reference_t<decltype(*a)>>;
+    if constexpr (std::is_same_v<T, float>) {
+      V4f f;
+      std::memcpy(&f, a, sizeof f);
+      return __builtin_convertvector(f, V);
+    } else {
+      V v;
+      std::memcpy(&v, a, sizeof v);
+      return v;
+    }
+  };
+  auto store = [](auto* a, const V& v) {
+    using T = std::remove_reference_t<decltype(*a)>;
+    if constexpr (std::is_same_v<T, float>) {
+      const V4f f = __builtin_convertvector(v, V4f);
+      std::memcpy(a, &f, sizeof f);
+    } else {
+      std::memcpy(a, &v, sizeof v);
+    }
+  };
+  auto pick = [](const M& m, const V& yes, const V& no) { return m ? yes : no; };
+  const V zero = {0, 0, 0, 0};
+  size_t p = begin;
+  for (; p + 4 <= end; p += 4) {
+    const uint8_t mat = P.material[p];
+    if (P.material[p + 1] != mat || P.material[p + 2] != mat || P.material[p + 3] != mat) {
+      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q);
+      continue;
+    }
+    const MaterialParams& mp = materials_[mat];
+    const V L00 = load(P.c00.data() + p), L01 = load(P.c01.data() + p), L10 = load(P.c10.data() + p),
+            L11 = load(P.c11.data() + p);
+    // kinematics (see update): the cubic for |e| < 1e-3, else the library's exp
+    const V e = dt * (L00 + L11);
+    const M small_e = (e < 1e-3) & (e > -1e-3);
+    V volume = load(P.volume.data() + p) * (1.0 + e * (1.0 + e * (0.5 + e / 6.0)));
+    if (!(small_e[0] && small_e[1] && small_e[2] && small_e[3])) {
+      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q);
+      continue;
+    }
+    const V phi = load(P.mass.data() + p) / (mp.rho_g * volume);
+    const double phi_d = mp.phi_c;
+    const M open = mp.separation ? M(phi < phi_d) : M{0, 0, 0, 0};
+    // elastic trial
+    const V trD = L00 + L11;
+    const V Dxy = 0.5 * (L01 + L10), w = 0.5 * (L01 - L10);
+    const V sxx = load(P.sxx.data() + p), syy = load(P.syy.data() + p), sxy = load(P.sxy.data() + p);
+    V txx = sxx + dt * (2.0 * mp.G * (L00 - trD / 3.0) + 2.0 * w * sxy);
+    V tyy = syy + dt * (2.0 * mp.G * (L11 - trD / 3.0) - 2.0 * w * sxy);
+    V txy = sxy + dt * (2.0 * mp.G * Dxy + w * (syy - sxx));
+    V tzz = load(P.szz.data() + p) + dt * (2.0 * mp.G * (-trD / 3.0));
+    const V tr3 = (txx + tyy + tzz) / 3.0;
+    txx -= tr3;
+    tyy -= tr3;
+    tzz -= tr3;
+    // P = K log_near_one(phi / phi_d): its series where |q - 1| <= 1e-3, else the library's log
+    const V q = phi / phi_d, x = q - 1.0;
+    const M series = (x <= 1e-3) & (x >= -1e-3);
+    V pressure = mp.K * (x * (1.0 - x * (0.5 - x * (1.0 / 3.0 - x * (0.25 - x * (0.2 - x * (1.0 / 6.0)))))));
+    for (int l = 0; l < 4; ++l)
+      if (!series[l] && !open[l]) pressure[l] = mp.K * std::log(q[l]);
+    const V tau = (V)_mm256_sqrt_pd((__m256d)(0.5 * (txx * txx + tyy * tyy + tzz * tzz) + txy * txy));
+    const V tau_max = mp.friction(phi_d) * pick(pressure < 0.0, zero, pressure);  // std::max(P, 0.0), -0 kept
+    const M plastic = ~(tau <= tau_max);
+    const V dgamma = (tau - tau_max) / mp.G;
+    const V scale = pick(tau > 0.0, tau_max / tau, zero);
+    auto out = [&](const V& trial) { return pick(open, zero, pick(plastic, trial * scale, trial)); };
+    store(P.volume.data() + p, volume);
+    store(P.sxx.data() + p, out(txx));
+    store(P.syy.data() + p, out(tyy));
+    store(P.sxy.data() + p, out(txy));
+    store(P.szz.data() + p, out(tzz));
+    store(P.pressure.data() + p, pick(open, zero, pressure));
+    if constexpr (Track) {
+      const M flows = plastic & ~open;
+      const V ps = load(P.plastic_strain.data() + p);
+      store(P.plastic_strain.data() + p, pick(flows, ps + dgamma, ps));
+      store(P.strain_rate.data() + p, pick(flows, dgamma / dt, zero));
+    }
+  }
+  return p;
+#endif
+}
+
+template <bool Dilatancy, bool Track, bool Rate>
+void Simulation::constitutive_point(size_t p) {
+  constitutive_range<Dilatancy, Track, Rate>(p, p + 1);  // one point: update(), never by four
+}
+
 template <bool Dilatancy, bool Track, bool Rate>
 void Simulation::constitutive_range(size_t begin, size_t end) {
+  if constexpr (!Dilatancy && !Rate)
+    if (by_four_ && begin + 1 < end) begin = constitutive_ndpm_by_four<Track>(begin, end);
   const double dt = dt_s_;
   std::vector<PlasticityModel<Dilatancy, Rate>> models;  // once per block of kGrain points: cheap
   for (const auto& m : materials_) models.push_back({m});

@@ -153,9 +153,9 @@ class Simulation {
   const PhaseSeconds& phase_seconds() const { return phase_s_; }
   // G2P and the constitutive update as one pass (default) or two (to time each; same results)
   void set_fused_particle_passes(bool fused) { fuse_particle_passes_ = fused; }
-  // The default P2G and G2P four points at a time (the default) or a point at a time: the same
-  // bits (tested).
-  void set_transfers_by_four(bool by_four) { transfers_by_four_ = by_four; }
+  // The default P2G and G2P and NDPM's update four points at a time (the default) or a point at
+  // a time: the same bits (tested).
+  void set_by_four(bool by_four) { by_four_ = by_four; }
   double wave_speed_m_s() const { return wave_speed_; }
   // distance travelled by the first moving body (m), for end_displacement and averaging windows
   double lead_body_travel_m() const;
@@ -201,6 +201,8 @@ class Simulation {
   size_t g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc);
   void p2g_strip_quadratic_by_four(int strip);
   template <bool Dilatancy, bool Track, bool Rate> void constitutive_range(size_t begin, size_t end);
+  template <bool Dilatancy, bool Track, bool Rate> void constitutive_point(size_t p);
+  template <bool Track> size_t constitutive_ndpm_by_four(size_t begin, size_t end);
   void particles_update(bool g2p, bool constitutive);
   void advance_bodies();
   void reorder_particles();
@@ -229,7 +231,7 @@ class Simulation {
   void (Simulation::*g2p_range_)(size_t, size_t, G2PLocal&) = nullptr;
   void (Simulation::*constitutive_range_)(size_t, size_t) = nullptr;
   bool fuse_particle_passes_ = true;
-  bool transfers_by_four_ = true;
+  bool by_four_ = true;
   void (Simulation::*contact_)() = nullptr;
   std::vector<ContactPoint> contacts_;
   // cell-fraction contact: per body, the nodes a point has touched; its field's sample points
