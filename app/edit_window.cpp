@@ -85,9 +85,12 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
     glfwGetCursorPos(xw.glfw, &mx, &my);
     const bool down = glfwGetMouseButton(xw.glfw, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
     const Vec2 p = view.layout(s.scene).to_m({mx, my});
-    if (xw.clicked_left && down && dragging < 0 && mx < view.panel_x0()) {
-      dragging = body_under(s.scene, p);
-      if (dragging >= 0) grab = p - s.scene.bodies[size_t(dragging)].start_m;
+    // a drag starts where the button went down and ends where it came up, whatever else the
+    // frame saw in between
+    if (xw.clicked_left && dragging < 0 && xw.press_x < view.panel_x0()) {
+      const Vec2 at = view.layout(s.scene).to_m({xw.press_x, xw.press_y});
+      dragging = body_under(s.scene, at);
+      if (dragging >= 0) grab = at - s.scene.bodies[size_t(dragging)].start_m;
     }
     in.clicked_left = xw.clicked_left && mx >= view.panel_x0();
     xw.clicked_left = false;
@@ -95,9 +98,14 @@ int run_edit_window(EditorState& s, render::SceneView& view, const EditWindowOpt
     // why) and the body stays at the last valid one
     if (dragging >= 0 && down) last = apply_edit(s, MoveBody{std::to_string(dragging), snapped(p - grab)}, &view);
     if (dragging >= 0 && !down) {
+      if (xw.released_left) {
+        const Vec2 at = view.layout(s.scene).to_m({xw.release_x, xw.release_y});
+        last = apply_edit(s, MoveBody{std::to_string(dragging), snapped(at - grab)}, &view);
+      }
       if (!last.is_null()) print(last);
       dragging = -1, last = nullptr;
     }
+    xw.released_left = false;
     // the panel: wheel scrolling, a clicked key's value typed (checked as typed, set on Enter),
     // the preview button
     in.mouse_x = float(mx), in.mouse_y = float(my), in.wheel = xw.wheel, xw.wheel = 0;

@@ -94,7 +94,10 @@ void open_window(XWindow& xw, int width, int height, const std::string& title) {
   glfwSetCursorPosCallback(xw.glfw, [](GLFWwindow* w, double, double) { self(w)->dirty = true; });
   glfwSetMouseButtonCallback(xw.glfw, [](GLFWwindow* w, int button, int action, int) {
     self(w)->dirty = true;
-    if (button == GLFW_MOUSE_BUTTON_LEFT && action == GLFW_PRESS) self(w)->clicked_left = true;
+    if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+    XWindow& xw = *self(w);
+    if (action == GLFW_PRESS) xw.clicked_left = true, glfwGetCursorPos(w, &xw.press_x, &xw.press_y);
+    if (action == GLFW_RELEASE) xw.released_left = true, glfwGetCursorPos(w, &xw.release_x, &xw.release_y);
   });
   glfwSetScrollCallback(xw.glfw, [](GLFWwindow* w, double, double dy) {
     self(w)->wheel += float(dy);

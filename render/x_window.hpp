@@ -29,6 +29,10 @@ struct XWindow {
   std::vector<int> key_mods;  // GLFW_MOD_* of each key in `keys`
   std::vector<unsigned> chars;  // text typed (Unicode code points)
   bool clicked_left = false;
+  bool released_left = false;
+  // where the cursor was at the last left press and release: a frame can see a press, the moves
+  // and the release at once, and the cursor's position then is only the last of them
+  double press_x = 0, press_y = 0, release_x = 0, release_y = 0;
 
   XWindow() = default;
   XWindow(const XWindow&) = delete;
