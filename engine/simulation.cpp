@@ -1198,7 +1198,7 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
   for (; p + 4 <= end; p += 4) {
     const uint8_t mat = P.material[p];
     if (P.material[p + 1] != mat || P.material[p + 2] != mat || P.material[p + 3] != mat) {
-      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q);
+      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q, {materials_[P.material[q]]});
       continue;
     }
     const MaterialParams& mp = materials_[mat];
@@ -1209,7 +1209,7 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
     const M small_e = (e < 1e-3) & (e > -1e-3);
     V volume = load(P.volume.data() + p) * (1.0 + e * (1.0 + e * (0.5 + e / 6.0)));
     if (!(small_e[0] && small_e[1] && small_e[2] && small_e[3])) {
-      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q);
+      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q, {materials_[P.material[q]]});
       continue;
     }
     const V phi = load(P.mass.data() + p) / (mp.rho_g * volume);
@@ -1256,35 +1256,33 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
 #endif
 }
 
+// One point's update: PlasticityModel::update on its stored state.
 template <bool Dilatancy, bool Track, bool Rate>
-void Simulation::constitutive_point(size_t p) {
-  constitutive_range<Dilatancy, Track, Rate>(p, p + 1);  // one point: update(), never by four
+void Simulation::constitutive_point(size_t p, const PlasticityModel<Dilatancy, Rate>& model) {
+  auto& P = p_;
+  PointState s{P.volume[p], P.sxx[p], P.syy[p], P.sxy[p], P.szz[p], P.pressure[p],
+               Dilatancy ? P.phi_d[p] : 0.0, Track ? P.plastic_strain[p] : 0.0, 0.0};
+  model.update(dt_s_, P.c00[p], P.c01[p], P.c10[p], P.c11[p], P.mass[p], s);
+  P.volume[p] = s.volume_m2;
+  P.sxx[p] = s.sxx;
+  P.syy[p] = s.syy;
+  P.sxy[p] = s.sxy;
+  P.szz[p] = s.szz;
+  P.pressure[p] = s.pressure_Pa;
+  if constexpr (Dilatancy) P.phi_d[p] = s.phi_d;
+  if constexpr (Track) {
+    P.plastic_strain[p] = s.plastic_strain;
+    P.strain_rate[p] = s.strain_rate_1_s;
+  }
 }
 
 template <bool Dilatancy, bool Track, bool Rate>
 void Simulation::constitutive_range(size_t begin, size_t end) {
   if constexpr (!Dilatancy && !Rate)
-    if (by_four_ && begin + 1 < end) begin = constitutive_ndpm_by_four<Track>(begin, end);
-  const double dt = dt_s_;
-  std::vector<PlasticityModel<Dilatancy, Rate>> models;  // once per block of kGrain points: cheap
+    if (by_four_) begin = constitutive_ndpm_by_four<Track>(begin, end);
+  std::vector<PlasticityModel<Dilatancy, Rate>> models;  // once per block of points: cheap
   for (const auto& m : materials_) models.push_back({m});
-  auto& P = p_;
-  for (size_t p = begin; p < end; ++p) {
-    PointState s{P.volume[p], P.sxx[p], P.syy[p], P.sxy[p], P.szz[p], P.pressure[p],
-                 Dilatancy ? P.phi_d[p] : 0.0, Track ? P.plastic_strain[p] : 0.0, 0.0};
-    models[P.material[p]].update(dt, P.c00[p], P.c01[p], P.c10[p], P.c11[p], P.mass[p], s);
-    P.volume[p] = s.volume_m2;
-    P.sxx[p] = s.sxx;
-    P.syy[p] = s.syy;
-    P.sxy[p] = s.sxy;
-    P.szz[p] = s.szz;
-    P.pressure[p] = s.pressure_Pa;
-    if constexpr (Dilatancy) P.phi_d[p] = s.phi_d;
-    if constexpr (Track) {
-      P.plastic_strain[p] = s.plastic_strain;
-      P.strain_rate[p] = s.strain_rate_1_s;
-    }
-  }
+  for (size_t p = begin; p < end; ++p) constitutive_point<Dilatancy, Track, Rate>(p, models[p_.material[p]]);
 }
 
 // G2P and the constitutive update. Fused, each block of particles gets both while it is in cache

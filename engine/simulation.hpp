@@ -201,7 +201,8 @@ class Simulation {
   size_t g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc);
   void p2g_strip_quadratic_by_four(int strip);
   template <bool Dilatancy, bool Track, bool Rate> void constitutive_range(size_t begin, size_t end);
-  template <bool Dilatancy, bool Track, bool Rate> void constitutive_point(size_t p);
+  template <bool Dilatancy, bool Track, bool Rate>
+  void constitutive_point(size_t p, const PlasticityModel<Dilatancy, Rate>& model);
   template <bool Track> size_t constitutive_ndpm_by_four(size_t begin, size_t end);
   void particles_update(bool g2p, bool constitutive);
   void advance_bodies();
