@@ -56,6 +56,28 @@ inline Vec4dU& four_at(double* first) { return *reinterpret_cast<Vec4dU*>(first)
 inline const Vec4dU& four_at(const double* first) { return *reinterpret_cast<const Vec4dU*>(first); }
 
 #if defined(__AVX__)
+typedef float Vec4f __attribute__((vector_size(16)));
+// Four consecutive values as doubles, and back (a float array rounds each once, as a scalar store).
+template <class T> inline Vec4d load4(const T* a) {
+  if constexpr (std::is_same_v<T, float>) {
+    Vec4f f;
+    std::memcpy(&f, a, sizeof f);
+    return __builtin_convertvector(f, Vec4d);
+  } else {
+    Vec4d v;
+    std::memcpy(&v, a, sizeof v);
+    return v;
+  }
+}
+template <class T> inline void store4(T* a, const Vec4d& v) {
+  if constexpr (std::is_same_v<T, float>) {
+    const Vec4f f = __builtin_convertvector(v, Vec4f);
+    std::memcpy(a, &f, sizeof f);
+  } else {
+    std::memcpy(a, &v, sizeof v);
+  }
+}
+
 // QuadraticKernel::weights for four points, a point per lane (the same arithmetic, the same bits);
 // returns the first node's index as doubles and fills `base` with it as ints
 inline Vec4d quadratic_weights_by_four(const Vec4d& x_m, double inv_dx, Vec4d w[3], int base[4]) {
@@ -976,22 +998,15 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
   // for the last
   auto group = [&](const size_t p, const auto count) {
     auto load = [&](const double* a) {
+      if (count == 4) return load4(a + p);
       V v;
-      if (count == 4) return std::memcpy(&v, a + p, sizeof v), v;
       for (size_t l = 0; l < 4; ++l) v[l] = a[p + std::min(l, size_t(count) - 1)];
       return v;
     };
     auto store = [&](auto* a, const V& v) {
       using T = std::remove_reference_t<decltype(*a)>;
-      if (count < 4) {
-        for (size_t l = 0; l < count; ++l) a[p + l] = T(v[l]);
-      } else if constexpr (std::is_same_v<T, float>) {
-        typedef float V4f __attribute__((vector_size(16)));
-        const V4f f = __builtin_convertvector(v, V4f);
-        std::memcpy(a + p, &f, sizeof f);
-      } else {
-        std::memcpy(a + p, &v, sizeof v);
-      }
+      if (count == 4) return store4(a + p, v);
+      for (size_t l = 0; l < count; ++l) a[p + l] = T(v[l]);
     };
     const V xp = load(X), yp = load(Y);
     V wx[3], wy[3], wxd[3], wyd[3];
@@ -1168,30 +1183,8 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
 #else
   using V = Vec4d;
   typedef long long M __attribute__((vector_size(32)));  // a lane mask
-  typedef float V4f __attribute__((vector_size(16)));
   const double dt = dt_s_;
   auto& P = p_;
-  auto load = [](const auto* a) {
-    using T = std::remove_const_t<std::remove_reference_t<decltype(*a)>>;
-    if constexpr (std::is_same_v<T, float>) {
-      V4f f;
-      std::memcpy(&f, a, sizeof f);
-      return __builtin_convertvector(f, V);
-    } else {
-      V v;
-      std::memcpy(&v, a, sizeof v);
-      return v;
-    }
-  };
-  auto store = [](auto* a, const V& v) {
-    using T = std::remove_reference_t<decltype(*a)>;
-    if constexpr (std::is_same_v<T, float>) {
-      const V4f f = __builtin_convertvector(v, V4f);
-      std::memcpy(a, &f, sizeof f);
-    } else {
-      std::memcpy(a, &v, sizeof v);
-    }
-  };
   auto pick = [](const M& m, const V& yes, const V& no) { return m ? yes : no; };
   const V zero = {0, 0, 0, 0};
   size_t p = begin;
@@ -1202,27 +1195,27 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
       continue;
     }
     const MaterialParams& mp = materials_[mat];
-    const V L00 = load(P.c00.data() + p), L01 = load(P.c01.data() + p), L10 = load(P.c10.data() + p),
-            L11 = load(P.c11.data() + p);
+    const V L00 = load4(P.c00.data() + p), L01 = load4(P.c01.data() + p), L10 = load4(P.c10.data() + p),
+            L11 = load4(P.c11.data() + p);
     // kinematics (see update): the cubic for |e| < 1e-3, else the library's exp
     const V e = dt * (L00 + L11);
     const M small_e = (e < 1e-3) & (e > -1e-3);
-    V volume = load(P.volume.data() + p) * (1.0 + e * (1.0 + e * (0.5 + e / 6.0)));
+    V volume = load4(P.volume.data() + p) * (1.0 + e * (1.0 + e * (0.5 + e / 6.0)));
     if (!(small_e[0] && small_e[1] && small_e[2] && small_e[3])) {
       for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q, {materials_[P.material[q]]});
       continue;
     }
-    const V phi = load(P.mass.data() + p) / (mp.rho_g * volume);
+    const V phi = load4(P.mass.data() + p) / (mp.rho_g * volume);
     const double phi_d = mp.phi_c;
     const M open = mp.separation ? M(phi < phi_d) : M{0, 0, 0, 0};
     // elastic trial
     const V trD = L00 + L11;
     const V Dxy = 0.5 * (L01 + L10), w = 0.5 * (L01 - L10);
-    const V sxx = load(P.sxx.data() + p), syy = load(P.syy.data() + p), sxy = load(P.sxy.data() + p);
+    const V sxx = load4(P.sxx.data() + p), syy = load4(P.syy.data() + p), sxy = load4(P.sxy.data() + p);
     V txx = sxx + dt * (2.0 * mp.G * (L00 - trD / 3.0) + 2.0 * w * sxy);
     V tyy = syy + dt * (2.0 * mp.G * (L11 - trD / 3.0) - 2.0 * w * sxy);
     V txy = sxy + dt * (2.0 * mp.G * Dxy + w * (syy - sxx));
-    V tzz = load(P.szz.data() + p) + dt * (2.0 * mp.G * (-trD / 3.0));
+    V tzz = load4(P.szz.data() + p) + dt * (2.0 * mp.G * (-trD / 3.0));
     const V tr3 = (txx + tyy + tzz) / 3.0;
     txx -= tr3;
     tyy -= tr3;
@@ -1239,17 +1232,17 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
     const V dgamma = (tau - tau_max) / mp.G;
     const V scale = pick(tau > 0.0, tau_max / tau, zero);
     auto out = [&](const V& trial) { return pick(open, zero, pick(plastic, trial * scale, trial)); };
-    store(P.volume.data() + p, volume);
-    store(P.sxx.data() + p, out(txx));
-    store(P.syy.data() + p, out(tyy));
-    store(P.sxy.data() + p, out(txy));
-    store(P.szz.data() + p, out(tzz));
-    store(P.pressure.data() + p, pick(open, zero, pressure));
+    store4(P.volume.data() + p, volume);
+    store4(P.sxx.data() + p, out(txx));
+    store4(P.syy.data() + p, out(tyy));
+    store4(P.sxy.data() + p, out(txy));
+    store4(P.szz.data() + p, out(tzz));
+    store4(P.pressure.data() + p, pick(open, zero, pressure));
     if constexpr (Track) {
       const M flows = plastic & ~open;
-      const V ps = load(P.plastic_strain.data() + p);
-      store(P.plastic_strain.data() + p, pick(flows, ps + dgamma, ps));
-      store(P.strain_rate.data() + p, pick(flows, dgamma / dt, zero));
+      const V ps = load4(P.plastic_strain.data() + p);
+      store4(P.plastic_strain.data() + p, pick(flows, ps + dgamma, ps));
+      store4(P.strain_rate.data() + p, pick(flows, dgamma / dt, zero));
     }
   }
   return p;
