@@ -392,7 +392,7 @@ void Simulation::particles_to_grid() {
   auto scatter_strip = [&](int s) {
     // locals, not captures: the grid stores below cannot change them, so they stay in registers
     GridNode* const nodes = grid;
-    const size_t NX = size_t(g_.NX);
+    const size_t NY = size_t(g_.NY);
     const uint32_t* const order = order_.data();
     const double *const X = P.x.data(), *const Y = P.y.data(), *const VX = P.vx.data(), *const VY = P.vy.data();
     const auto *const C00 = P.c00.data(), *const C01 = P.c01.data(), *const C10 = P.c10.data(), *const C11 = P.c11.data();
@@ -440,11 +440,11 @@ void Simulation::particles_to_grid() {
           v[a] = wx[a] * s11;
         }
         for (int b = 0; b < K::N; ++b) {
-          GridNode* const row = nodes + Grid::index(bx, by + b, NX);
+          GridNode* const row = nodes + Grid::index(bx, by + b, NY);
           const double wb = wy[b], wdb = wy[b] * (dy0 + b * h);
           for (int a = 0; a < K::N; ++a) {
-            four_at(&row[a].m) += wb * Ua[a] + wdb * Va[a];
-            row[a].vy0 += wb * u[a] + wdb * v[a];
+            four_at(&row[a * NY].m) += wb * Ua[a] + wdb * Va[a];
+            row[a * NY].vy0 += wb * u[a] + wdb * v[a];
           }
         }
         continue;
@@ -455,7 +455,7 @@ void Simulation::particles_to_grid() {
         for (int a = 0; a < K::N; ++a) {
           const double dxp = dx0 + a * dx;
           const double w = wx[a] * wy[b];
-          GridNode& n = row[a];
+          GridNode& n = row[a * NY];
           n.m += w * m;
           n.vx += w * (mvx + q00 * dxp + q01 * dyp);
           n.vy += w * (mvy + q10 * dxp + q11 * dyp);
@@ -502,7 +502,7 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
   using V = Vec4d;
   const double h = g_.dx, ih = 1.0 / h, dt = dt_s_, Dinv = QuadraticKernel::inv_D(ih);
   GridNode* const nodes = g_.node.data();
-  const size_t NX = size_t(g_.NX);
+  const size_t NY = size_t(g_.NY);
   const uint32_t* const order = order_.data();
   const Particles& P = p_;
   const uint32_t k0 = strip_start_[size_t(strip)], k1 = strip_start_[size_t(strip) + 1];
@@ -538,11 +538,11 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
         Va[a] = wx[a][l] * colB;
       }
       for (int b = 0; b < 3; ++b) {
-        GridNode* const row = nodes + Grid::index(bx[l], by[l] + b, NX);
+        GridNode* const row = nodes + Grid::index(bx[l], by[l] + b, NY);
         const double wb = wy[b][l], wdb = wdy[b][l];
         for (int a = 0; a < 3; ++a) {
-          four_at(&row[a].m) += wb * Ua[a] + wdb * Va[a];
-          row[a].vy0 += wb * u[a][l] + wdb * v[a][l];
+          four_at(&row[a * NY].m) += wb * Ua[a] + wdb * Va[a];
+          row[a * NY].vy0 += wb * u[a][l] + wdb * v[a][l];
         }
       }
     }
@@ -798,7 +798,7 @@ void Simulation::find_contact_points() {
       for (int i = 0; i < K::N; ++i) {
         const double w = wx[i] * wy[j];
         c.w[j * K::N + i] = w;
-        const double m = g_.node[c.base + size_t(j) * g_.NX + i].m;
+        const double m = g_.node[c.base + size_t(j) + size_t(i) * size_t(g_.NY)].m;
         if (m > 0.0) sum += w * w / m;
       }
     c.inv_meff = sum;
@@ -846,7 +846,7 @@ void Simulation::apply_contact_impulse(const ContactPoint& c, const Vec2& J) {
   GridNode* grid = g_.node.data();
   for (int j = 0; j < K::N; ++j)
     for (int i = 0; i < K::N; ++i) {
-      GridNode& nd = grid[c.base + size_t(j) * size_t(g_.NX) + i];
+      GridNode& nd = grid[c.base + size_t(j) + size_t(i) * size_t(g_.NY)];
       if (nd.m <= 0.0) continue;
       const double f = c.w[j * K::N + i] / nd.m;
       nd.vx += f * J.x();
@@ -861,7 +861,7 @@ void Simulation::solve_contact_points() {
   const double dt = dt_s_;
   const size_t nb = bodies_.size();
   const GridNode* grid = g_.node.data();
-  const size_t NX = size_t(g_.NX);
+  const size_t NY = size_t(g_.NY);
   double vscale = 1e-3;
   for (const auto& s : bodies_) vscale = std::max(vscale, s.velocity_m_s.norm());
   const double tol = 1e-5 * vscale;
@@ -874,7 +874,7 @@ void Simulation::solve_contact_points() {
       double vx = 0.0, vy = 0.0;
       for (int j = 0; j < K::N; ++j)
         for (int i = 0; i < K::N; ++i) {
-          const GridNode& nd = grid[c.base + size_t(j) * NX + i];
+          const GridNode& nd = grid[c.base + size_t(j) + size_t(i) * NY];
           const double w = c.w[j * K::N + i];
           vx += w * nd.vx;
           vy += w * nd.vy;
@@ -978,7 +978,7 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
   if (nb > kMaxBodies) return begin;
   const double dx = g_.dx, ih = 1.0 / dx, dt = dt_s_, alpha = scene_.solver.flip_blend;
   const double sc = QuadraticKernel::inv_D(ih);
-  const size_t NX = size_t(g_.NX);
+  const size_t NY = size_t(g_.NY);
   const GridNode* const grid = g_.node.data();
   // each body's box in world coordinates, a little wider: only a lane inside one goes on to the
   // safety net's own test
@@ -1021,10 +1021,10 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     for (int l = 0; l < 4; ++l) {
       V vl = zero, axl = zero, ayl = zero;
       for (int b = 0; b < 3; ++b) {
-        const GridNode* row = grid + Grid::index(bx[l], by[l] + b, NX);
+        const GridNode* row = grid + Grid::index(bx[l], by[l] + b, NY);
         V R = zero, S = zero;
         for (int a = 0; a < 3; ++a) {
-          const V g = four_at(&row[a].vx);
+          const V g = four_at(&row[a * NY].vx);
           R += wx[a][l] * g;
           S += wxd[a][l] * g;
         }
@@ -1087,6 +1087,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   auto& P = p_;
   if constexpr (std::is_same_v<K, QuadraticKernel> && Flip)
     if (by_four_) begin = g2p_quadratic_by_four(begin, end, loc);
+  const size_t NY = size_t(g_.NY);
   for (size_t p = begin; p < end; ++p) {
     double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
     const double xp = P.x[p], yp = P.y[p];
@@ -1106,7 +1107,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
         const GridNode* row = &g_.node[g_.index(bx, by + b)];
         Vec4d R = {0, 0, 0, 0}, S = {0, 0, 0, 0};
         for (int a = 0; a < K::N; ++a) {
-          const Vec4d g = four_at(&row[a].vx);
+          const Vec4d g = four_at(&row[a * NY].vx);
           R += wx[a] * g;
           S += wxd[a] * g;
         }
@@ -1122,7 +1123,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
         const double dyp = (by + b) * dx - yp;
         for (int a = 0; a < K::N; ++a) {
           const double w = wx[a] * wy[b];
-          const GridNode& n = row[a];
+          const GridNode& n = row[a * NY];
           const double gvx = n.vx, gvy = n.vy;
           vx += w * gvx;
           vy += w * gvy;

@@ -81,11 +81,15 @@ struct Grid {
   int NX = 0, NY = 0;      // nodes including padding
   double dx = 0.0;
   std::vector<GridNode> node;
-  size_t index(int i, int j) const { return index(i, j, size_t(NX)); }
-  // the same with the row length held by the caller (a local the hot loops keep in a register)
-  static size_t index(int i, int j, size_t NX) { return size_t(j + kPad) * NX + size_t(i + kPad); }
-  double node_x(size_t k) const { return (int(k % NX) - kPad) * dx; }
-  double node_y(size_t k) const { return (int(k / NX) - kPad) * dx; }
+  // Column-major (a column of nodes is contiguous): the particles of a strip, walked row by row,
+  // then touch kStripCells + 2 columns each read in order, which the prefetchers follow; row-major,
+  // every new row of a strip is a cache miss once the grid is out of cache (README, Performance).
+  size_t index(int i, int j) const { return index(i, j, size_t(NY)); }
+  // the same with the column length held by the caller (a local the hot loops keep in a register);
+  // it is also the step from a node to its neighbour in x
+  static size_t index(int i, int j, size_t NY) { return size_t(i + kPad) * NY + size_t(j + kPad); }
+  double node_x(size_t k) const { return (int(k / NY) - kPad) * dx; }
+  double node_y(size_t k) const { return (int(k % NY) - kPad) * dx; }
 };
 
 struct BodyState {
