@@ -1172,13 +1172,15 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
   }
 }
 
-// NDPM's update (PlasticityModel<false>::update) four points at a time, a point per lane: the same
-// operations in the same order, the branches as lane selects (the same bits, tested). A group
-// whose points are of different materials, or a lane that needs the library's exp or log (a
-// volume strain of 1e-3 in a step), goes through update() instead. Returns `end`, or where
-// constitutive_range's loop must take over when built without AVX.
-template <bool Track>
-size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
+// The rate-independent update (PlasticityModel<Dilatancy>::update) four points at a time, a point
+// per lane: the same operations in the same order, the branches as lane selects (the same bits,
+// tested). A group whose points are of different materials, or a lane whose volume strain needs the
+// library's exp (1e-3 in a step), goes through update() instead; the library's log (pressure away
+// from the dense state) and DPM's exp (the packing's relaxation in a yielding lane) are called per
+// lane, as update() calls them. Returns `end`, or where constitutive_range's loop must take over
+// when built without AVX.
+template <bool Dilatancy, bool Track>
+size_t Simulation::constitutive_by_four(size_t begin, size_t end) {
 #if !defined(__AVX__)
   return begin;
 #else
@@ -1188,11 +1190,12 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
   auto& P = p_;
   auto pick = [](const M& m, const V& yes, const V& no) { return m ? yes : no; };
   const V zero = {0, 0, 0, 0};
+  auto scalar = [&](size_t q) { constitutive_point<Dilatancy, Track, false>(q, {materials_[P.material[q]]}); };
   size_t p = begin;
   for (; p + 4 <= end; p += 4) {
     const uint8_t mat = P.material[p];
     if (P.material[p + 1] != mat || P.material[p + 2] != mat || P.material[p + 3] != mat) {
-      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q, {materials_[P.material[q]]});
+      for (size_t q = p; q < p + 4; ++q) scalar(q);
       continue;
     }
     const MaterialParams& mp = materials_[mat];
@@ -1203,12 +1206,29 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
     const M small_e = (e < 1e-3) & (e > -1e-3);
     V volume = load4(P.volume.data() + p) * (1.0 + e * (1.0 + e * (0.5 + e / 6.0)));
     if (!(small_e[0] && small_e[1] && small_e[2] && small_e[3])) {
-      for (size_t q = p; q < p + 4; ++q) constitutive_point<false, Track, false>(q, {materials_[P.material[q]]});
+      for (size_t q = p; q < p + 4; ++q) scalar(q);
       continue;
     }
     const V phi = load4(P.mass.data() + p) / (mp.rho_g * volume);
-    const double phi_d = mp.phi_c;
+    const V phi_d = Dilatancy ? load4(P.phi_d.data() + p) : zero + mp.phi_c;
     const M open = mp.separation ? M(phi < phi_d) : M{0, 0, 0, 0};
+    // MaterialParams::friction: std::max(0.0, mu + (phi_d - phi_c) chi)
+    auto friction = [&](const V& pd) {
+      if constexpr (!Dilatancy) return zero + mp.friction(mp.phi_c);
+      const V f = mp.mu + (pd - mp.phi_c) * mp.chi;
+      return pick(zero < f, f, zero);
+    };
+    // P = K log_near_one(phi / phi_d): its series where |q - 1| <= 1e-3, else the library's log
+    // (the lanes in `needed`; the others take the series, whatever it gives there)
+    auto pressure_of = [&](const V& pd, const M& needed) {
+      const V q = phi / pd, x = q - 1.0;
+      const M series = (x <= 1e-3) & (x >= -1e-3);
+      V pressure = mp.K * (x * (1.0 - x * (0.5 - x * (1.0 / 3.0 - x * (0.25 - x * (0.2 - x * (1.0 / 6.0)))))));
+      for (int l = 0; l < 4; ++l)
+        if (!series[l] && needed[l]) pressure[l] = mp.K * std::log(q[l]);
+      return pressure;
+    };
+    auto positive = [&](const V& v) { return pick(v < 0.0, zero, v); };  // std::max(v, 0.0), -0 kept
     // elastic trial
     const V trD = L00 + L11;
     const V Dxy = 0.5 * (L01 + L10), w = 0.5 * (L01 - L10);
@@ -1221,16 +1241,27 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
     txx -= tr3;
     tyy -= tr3;
     tzz -= tr3;
-    // P = K log_near_one(phi / phi_d): its series where |q - 1| <= 1e-3, else the library's log
-    const V q = phi / phi_d, x = q - 1.0;
-    const M series = (x <= 1e-3) & (x >= -1e-3);
-    V pressure = mp.K * (x * (1.0 - x * (0.5 - x * (1.0 / 3.0 - x * (0.25 - x * (0.2 - x * (1.0 / 6.0)))))));
-    for (int l = 0; l < 4; ++l)
-      if (!series[l] && !open[l]) pressure[l] = mp.K * std::log(q[l]);
+    V pressure = pressure_of(phi_d, ~open);
     const V tau = (V)_mm256_sqrt_pd((__m256d)(0.5 * (txx * txx + tyy * tyy + tzz * tzz) + txy * txy));
-    const V tau_max = mp.friction(phi_d) * pick(pressure < 0.0, zero, pressure);  // std::max(P, 0.0), -0 kept
+    V tau_max = friction(phi_d) * positive(pressure);
     const M plastic = ~(tau <= tau_max);
     const V dgamma = (tau - tau_max) / mp.G;
+    const M flows = plastic & ~open;
+    if constexpr (Dilatancy) {
+      // the yielding lanes relax phi_d toward phi_c and take the pressure and friction it gives
+      V relaxed = phi_d;
+      bool any = false;
+      for (int l = 0; l < 4; ++l)
+        if (flows[l]) relaxed[l] = mp.phi_c + (phi_d[l] - mp.phi_c) * std::exp(-mp.chi * mp.phi_c * dgamma[l]), any = true;
+      if (any) {
+        const V relaxed_pressure = pressure_of(relaxed, flows);
+        pressure = pick(flows, relaxed_pressure, pressure);
+        tau_max = pick(flows, (friction(relaxed) + 0.0) * positive(relaxed_pressure), tau_max);
+      }
+      // open: stress-free, and compaction below phi_min forgotten
+      const V forgotten = pick(phi < mp.phi_min, zero + mp.phi_min, phi_d);
+      store4(P.phi_d.data() + p, pick(open, forgotten, relaxed));
+    }
     const V scale = pick(tau > 0.0, tau_max / tau, zero);
     auto out = [&](const V& trial) { return pick(open, zero, pick(plastic, trial * scale, trial)); };
     store4(P.volume.data() + p, volume);
@@ -1240,7 +1271,6 @@ size_t Simulation::constitutive_ndpm_by_four(size_t begin, size_t end) {
     store4(P.szz.data() + p, out(tzz));
     store4(P.pressure.data() + p, pick(open, zero, pressure));
     if constexpr (Track) {
-      const M flows = plastic & ~open;
       const V ps = load4(P.plastic_strain.data() + p);
       store4(P.plastic_strain.data() + p, pick(flows, ps + dgamma, ps));
       store4(P.strain_rate.data() + p, pick(flows, dgamma / dt, zero));
@@ -1272,8 +1302,8 @@ void Simulation::constitutive_point(size_t p, const PlasticityModel<Dilatancy, R
 
 template <bool Dilatancy, bool Track, bool Rate>
 void Simulation::constitutive_range(size_t begin, size_t end) {
-  if constexpr (!Dilatancy && !Rate)
-    if (by_four_) begin = constitutive_ndpm_by_four<Track>(begin, end);
+  if constexpr (!Rate)
+    if (by_four_) begin = constitutive_by_four<Dilatancy, Track>(begin, end);
   std::vector<PlasticityModel<Dilatancy, Rate>> models;  // once per block of points: cheap
   for (const auto& m : materials_) models.push_back({m});
   for (size_t p = begin; p < end; ++p) constitutive_point<Dilatancy, Track, Rate>(p, models[p_.material[p]]);

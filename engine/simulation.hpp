@@ -207,7 +207,7 @@ class Simulation {
   template <bool Dilatancy, bool Track, bool Rate> void constitutive_range(size_t begin, size_t end);
   template <bool Dilatancy, bool Track, bool Rate>
   void constitutive_point(size_t p, const PlasticityModel<Dilatancy, Rate>& model);
-  template <bool Track> size_t constitutive_ndpm_by_four(size_t begin, size_t end);
+  template <bool Dilatancy, bool Track> size_t constitutive_by_four(size_t begin, size_t end);
   void particles_update(bool g2p, bool constitutive);
   void advance_bodies();
   void reorder_particles();

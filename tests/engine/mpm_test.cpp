@@ -133,29 +133,45 @@ static void expect_same_particles(const Particles& a, const Particles& b) {
   for (size_t k = 0; k < in_a.size(); ++k) EXPECT_TRUE(in_a[k].second == in_b[k].second) << in_a[k].first << " differs";
 }
 
-// The default P2G and G2P and NDPM's update run four points at a time (a point per SIMD lane) and
-// must give what the point by point loops give, bit for bit: strips and ranges that do not divide
-// by four, points the safety net puts back on the plate's surface, the points' margins, open and
-// yielding material included.
+// The default P2G and G2P and the rate-independent update (NDPM and DPM) run four points at a time
+// (a point per SIMD lane) and must give what the point by point loops give, bit for bit: strips and
+// ranges that do not divide by four, points the safety net puts back on the plate's surface, the
+// points' margins, open and yielding material, DPM's relaxing packing included.
 TEST(Mpm, FourWideTransfersGiveTheSameBitsAsThePointByPointLoops) {
-  Scene s = bed_scene(test_scenes::glass_beads(), 0.205, 0.105, 0.03, 0.005, 1.0, 0.58);  // 41 x 21 cells
-  s.bodies.push_back(plate(0.04, 0.01, 0.1, 0.095, Vec2(0.3, -0.6)));  // fast and sunk: the net acts
-  s.solver.particles_per_cell_1d = 3;  // 9 a cell: a point count that does not divide by four
-  s.outputs.fields = {"plastic_strain"};  // the NDPM update's tracked state too
-  s.solver.threads = 2;
-  Simulation four(s), one(s);
-  one.set_by_four(false);
-  int64_t projected = 0;
-  for (int k = 0; k < 300; ++k) {
-    four.step();
-    one.step();
-    projected += four.stats().projected_particles;
+  for (MaterialModel model : {MaterialModel::NDPM, MaterialModel::DPM}) {
+    SCOPED_TRACE(model == MaterialModel::DPM ? "DPM" : "NDPM");
+    Material m = test_scenes::glass_beads();
+    m.model = model;
+    m.chi = model == MaterialModel::DPM ? 5.0 : 0.0;
+    m.phi_min = 0.55;
+    Scene s = bed_scene(m, 0.205, 0.105, 0.03, 0.005, 1.0, 0.58);  // 41 x 21 cells
+    s.effects.dilatancy = model == MaterialModel::DPM;
+    s.bodies.push_back(plate(0.04, 0.01, 0.1, 0.095, Vec2(0.3, -0.6)));  // fast and sunk: the net acts
+    s.solver.particles_per_cell_1d = 3;  // 9 a cell: a point count that does not divide by four
+    s.outputs.fields = {"plastic_strain"};  // the update's tracked state too
+    s.solver.threads = 2;
+    Simulation four(s), one(s);
+    one.set_by_four(false);
+    int64_t projected = 0;
+    for (int k = 0; k < 300; ++k) {
+      four.step();
+      one.step();
+      projected += four.stats().projected_particles;
+    }
+    EXPECT_GT(projected, 0);
+    EXPECT_NE(four.particles().size() % 4, 0u);
+    if (model == MaterialModel::DPM) {  // the packing relaxed somewhere and was forgotten somewhere
+      const auto& phi_d = four.particles().phi_d;
+      ASSERT_EQ(phi_d.size(), four.particles().size());
+      const auto [lo, hi] = std::minmax_element(phi_d.begin(), phi_d.end());
+      EXPECT_EQ(*lo, m.phi_min);
+      EXPECT_GT(*hi, *lo);
+      EXPECT_GT(std::count_if(phi_d.begin(), phi_d.end(), [&](double v) { return v != *lo && v != *hi; }), 0);
+    }
+    EXPECT_EQ(four.bodies()[0].force_N_per_m, one.bodies()[0].force_N_per_m);
+    EXPECT_EQ(four.time_s(), one.time_s());  // the step: from the largest speed
+    expect_same_particles(four.particles(), one.particles());
   }
-  EXPECT_GT(projected, 0);
-  EXPECT_NE(four.particles().size() % 4, 0u);
-  EXPECT_EQ(four.bodies()[0].force_N_per_m, one.bodies()[0].force_N_per_m);
-  EXPECT_EQ(four.time_s(), one.time_s());  // the step: from the largest speed
-  expect_same_particles(four.particles(), one.particles());
 }
 
 // G2P and the constitutive update fused into one pass over each block of particles (the default)
@@ -166,6 +182,7 @@ TEST(Mpm, FusedParticlePassGivesTheSameBitsAsTwoPasses) {
   m.model = MaterialModel::DPM;
   m.phi_min = 0.55;
   Scene s = bed_scene(m, 0.2, 0.1, 0.03, 0.005, 1.0, 0.58);
+  s.effects.dilatancy = true;  // off by default: without it a DPM material keeps no packing state
   s.bodies.push_back(plate(0.04, 0.01, 0.1, 0.101, Vec2(0.0, -0.2)));
   s.outputs.fields = {"plastic_strain"};
   s.solver.threads = 2;
@@ -176,6 +193,7 @@ TEST(Mpm, FusedParticlePassGivesTheSameBitsAsTwoPasses) {
     apart.step();
   }
   EXPECT_NE(fused.bodies()[0].force_N_per_m.y(), 0.0);
+  ASSERT_EQ(fused.particles().phi_d.size(), fused.particles().size());
   EXPECT_EQ(fused.bodies()[0].force_N_per_m, apart.bodies()[0].force_N_per_m);
   expect_same_particles(fused.particles(), apart.particles());
   EXPECT_GT(fused.phase_seconds().g2p_constitutive, 0.0);
