@@ -55,6 +55,24 @@ typedef double Vec4dU __attribute__((vector_size(32), aligned(8)));
 inline Vec4dU& four_at(double* first) { return *reinterpret_cast<Vec4dU*>(first); }
 inline const Vec4dU& four_at(const double* first) { return *reinterpret_cast<const Vec4dU*>(first); }
 
+// a * b + c rounded once (lane by lane), where the machine has FMA. Written out where two paths'
+// sums must agree to the bit: left to the compiler, which product of `x * y + z * w` it fuses can
+// change with the code around it. Without FMA, unfused (a library fma would be slow).
+inline Vec4d fma4(const Vec4d& a, const Vec4d& b, const Vec4d& c) {
+#if defined(__FMA__)
+  return (Vec4d)_mm256_fmadd_pd((__m256d)a, (__m256d)b, (__m256d)c);
+#else
+  return a * b + c;
+#endif
+}
+inline double fma1(double a, double b, double c) {
+#if defined(__FMA__)
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
 #if defined(__AVX__)
 typedef float Vec4f __attribute__((vector_size(16)));
 // Four consecutive values as doubles, and back (a float array rounds each once, as a scalar store).
@@ -434,7 +452,7 @@ void Simulation::particles_to_grid() {
         double u[K::N], v[K::N];
         for (int a = 0; a < K::N; ++a) {
           const double dxp = dx0 + a * h;
-          Ua[a] = wx[a] * (base + dxp * colA);
+          Ua[a] = wx[a] * fma4(Vec4d{} + dxp, colA, base);
           Va[a] = wx[a] * colB;
           u[a] = wx[a] * dxp * s01;
           v[a] = wx[a] * s11;
@@ -443,8 +461,8 @@ void Simulation::particles_to_grid() {
           GridNode* const row = nodes + Grid::index(bx, by + b, NY);
           const double wb = wy[b], wdb = wy[b] * (dy0 + b * h);
           for (int a = 0; a < K::N; ++a) {
-            four_at(&row[a * NY].m) += wb * Ua[a] + wdb * Va[a];
-            row[a * NY].vy0 += wb * u[a] + wdb * v[a];
+            four_at(&row[a * NY].m) += fma4(Vec4d{} + wb, Ua[a], wdb * Va[a]);
+            row[a * NY].vy0 += fma1(wb, u[a], wdb * v[a]);
           }
         }
         continue;
@@ -493,6 +511,18 @@ void Simulation::particles_to_grid() {
     tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) { scatter_strip(2 * k + colour); });
 }
 
+#if defined(__AVX__)
+// out[l] = {a[l], b[l], c[l], d[l]}: four lane vectors to four per-lane vectors
+inline void transpose4(const Vec4d& a, const Vec4d& b, const Vec4d& c, const Vec4d& d, Vec4d out[4]) {
+  const __m256d ab_lo = _mm256_unpacklo_pd((__m256d)a, (__m256d)b), ab_hi = _mm256_unpackhi_pd((__m256d)a, (__m256d)b);
+  const __m256d cd_lo = _mm256_unpacklo_pd((__m256d)c, (__m256d)d), cd_hi = _mm256_unpackhi_pd((__m256d)c, (__m256d)d);
+  out[0] = (Vec4d)_mm256_permute2f128_pd(ab_lo, cd_lo, 0x20);
+  out[1] = (Vec4d)_mm256_permute2f128_pd(ab_hi, cd_hi, 0x20);
+  out[2] = (Vec4d)_mm256_permute2f128_pd(ab_lo, cd_lo, 0x31);
+  out[3] = (Vec4d)_mm256_permute2f128_pd(ab_hi, cd_hi, 0x31);
+}
+#endif
+
 // The default P2G (quadratic B-splines, FLIP) of one strip, four points at a time: a point per
 // lane for its weights, stress and affine terms and the per-column factors of scatter_strip's
 // default path; the scatter itself stays a point at a time, in the strip's order (the same sums
@@ -505,6 +535,7 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
   const size_t NY = size_t(g_.NY);
   const uint32_t* const order = order_.data();
   const Particles& P = p_;
+  const V zero = {0, 0, 0, 0};
   const uint32_t k0 = strip_start_[size_t(strip)], k1 = strip_start_[size_t(strip) + 1];
   for (uint32_t k = k0; k < k1; k += 4) {
     // a strip's last group fills its empty lanes with its last point and scatters only the real ones
@@ -530,19 +561,25 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
       v[a] = wx[a] * s11;
       wdy[a] = wy[a] * (dy0 + a * h);
     }
+    // scatter_strip's column factors U_a = wx_a (base + dxp_a colA), V_a = wx_a colB, field by field
+    // for the four points, then turned into a [m vx vy vx0] vector per point (a 4x4 transpose); the
+    // fifth field's nine node terms for the four points at once
+    V Ua[3][4], Va[3][4], fifth[3][3];
+    for (int a = 0; a < 3; ++a) {
+      transpose4(wx[a] * fma4(dxp[a], zero, m), wx[a] * fma4(dxp[a], q00, mvx), wx[a] * fma4(dxp[a], q10, mvy),
+                 wx[a] * fma4(dxp[a], s00, zero), Ua[a]);
+      transpose4(wx[a] * zero, wx[a] * q01, wx[a] * q11, wx[a] * s01, Va[a]);
+      for (int b = 0; b < 3; ++b) fifth[a][b] = fma4(wy[b], u[a], wdy[b] * v[a]);
+    }
     for (uint32_t l = 0; l < count; ++l) {
-      const V base = {m[l], mvx[l], mvy[l], 0.0}, colA = {0.0, q00[l], q10[l], s00[l]}, colB = {0.0, q01[l], q11[l], s01[l]};
-      V Ua[3], Va[3];
-      for (int a = 0; a < 3; ++a) {
-        Ua[a] = wx[a][l] * (base + dxp[a][l] * colA);
-        Va[a] = wx[a][l] * colB;
-      }
+      GridNode* const column0 = nodes + Grid::index(bx[l], by[l], NY);
+      GridNode* const column[3] = {column0, column0 + NY, column0 + 2 * NY};
       for (int b = 0; b < 3; ++b) {
-        GridNode* const row = nodes + Grid::index(bx[l], by[l] + b, NY);
-        const double wb = wy[b][l], wdb = wdy[b][l];
+        const V wb = (V)_mm256_broadcast_sd(&wy[b][l]), wdb = (V)_mm256_broadcast_sd(&wdy[b][l]);
         for (int a = 0; a < 3; ++a) {
-          four_at(&row[a * NY].m) += wb * Ua[a] + wdb * Va[a];
-          row[a * NY].vy0 += wb * u[a][l] + wdb * v[a][l];
+          GridNode& n = column[a][b];
+          four_at(&n.m) += fma4(wb, Ua[a][l], wdb * Va[a][l]);
+          n.vy0 += fifth[a][b][l];
         }
       }
     }
@@ -1018,19 +1055,21 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     }
     // the gather of [vx vy vx0 vy0], as in g2p_range: per row R = sum wx g, S = sum wx dxp g
     V vel[4], ax[4], ay[4];
+    auto lane = [](const V& v, int l) { return (V)_mm256_broadcast_sd(&v[l]); };
     for (int l = 0; l < 4; ++l) {
       V vl = zero, axl = zero, ayl = zero;
+      const GridNode* const column0 = grid + Grid::index(bx[l], by[l], NY);
+      const GridNode* const column[3] = {column0, column0 + NY, column0 + 2 * NY};
       for (int b = 0; b < 3; ++b) {
-        const GridNode* row = grid + Grid::index(bx[l], by[l] + b, NY);
         V R = zero, S = zero;
         for (int a = 0; a < 3; ++a) {
-          const V g = four_at(&row[a * NY].vx);
-          R += wx[a][l] * g;
-          S += wxd[a][l] * g;
+          const V g = four_at(&column[a][b].vx);
+          R += lane(wx[a], l) * g;
+          S += lane(wxd[a], l) * g;
         }
-        vl += wy[b][l] * R;
-        axl += wy[b][l] * S;
-        ayl += wyd[b][l] * R;
+        vl += lane(wy[b], l) * R;
+        axl += lane(wy[b], l) * S;
+        ayl += lane(wyd[b], l) * R;
       }
       vel[l] = vl, ax[l] = axl, ay[l] = ayl;
     }
