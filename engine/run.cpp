@@ -319,9 +319,9 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   double wall_before_s = 0.0, solver_before_s = 0.0;  // earlier segments of a resumed run
   double checkpoint_s = 0.0;  // writing checkpoints, all segments: not solver time
   int segments = 1;
-  const double fraction0 = fraction();
   clock::time_point loop0;  // the solver loop's start in this segment
   int64_t steps0 = 0;       // and the step it started from
+  double fraction0 = 0.0;   // and how far the run was then
   auto last_report = clock::now();
   auto report = [&](bool force_report) {
     if (!opt.progress) return;
@@ -334,10 +334,13 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     p.steps = sim.step_count();
     const double segment_s = std::chrono::duration<double>(now - wall0).count();
     p.wall_s = wall_before_s + segment_s;
-    p.eta_s = p.fraction - fraction0 > 0.01 ? segment_s * (1.0 - p.fraction) / (p.fraction - fraction0) : -1.0;
+    // from the loop's own pace (set-up and a checkpoint's loading left out), once it has run a few
+    // seconds: a resumed paper-size run used to wait for 1% of the run (minutes) before showing one
+    const double loop_s = std::chrono::duration<double>(now - loop0).count();
+    const double done = p.fraction - fraction0;
+    p.eta_s = loop_s >= 5.0 && done > 0.0 ? loop_s * (1.0 - p.fraction) / done : -1.0;
     p.particles = sim.particles().size();
     p.dt_s = sim.last_dt_s();
-    const double loop_s = std::chrono::duration<double>(now - loop0).count();
     p.particle_steps_per_s = loop_s > 0.0 ? double(p.particles) * double(p.steps - steps0) / loop_s : 0.0;
     opt.progress(p);
   };
@@ -372,6 +375,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   }
   loop0 = clock::now();
   steps0 = sim.step_count();
+  fraction0 = fraction();
   // The run's state after a step, written beside the old checkpoint and swapped in by two renames
   // (find_checkpoint takes checkpoint.old if a crash falls between them).
   double segment_checkpoint_s = 0.0;
