@@ -65,6 +65,7 @@ inline Vec4d fma4(const Vec4d& a, const Vec4d& b, const Vec4d& c) {
   return a * b + c;
 #endif
 }
+inline Vec4d splat(double v) { return Vec4d{v, v, v, v}; }
 inline double fma1(double a, double b, double c) {
 #if defined(__FMA__)
   return std::fma(a, b, c);
@@ -452,7 +453,7 @@ void Simulation::particles_to_grid() {
         double u[K::N], v[K::N];
         for (int a = 0; a < K::N; ++a) {
           const double dxp = dx0 + a * h;
-          Ua[a] = wx[a] * fma4(Vec4d{} + dxp, colA, base);
+          Ua[a] = wx[a] * fma4(splat(dxp), colA, base);
           Va[a] = wx[a] * colB;
           u[a] = wx[a] * dxp * s01;
           v[a] = wx[a] * s11;
@@ -461,7 +462,7 @@ void Simulation::particles_to_grid() {
           GridNode* const row = nodes + Grid::index(bx, by + b, NY);
           const double wb = wy[b], wdb = wy[b] * (dy0 + b * h);
           for (int a = 0; a < K::N; ++a) {
-            four_at(&row[a * NY].m) += fma4(Vec4d{} + wb, Ua[a], wdb * Va[a]);
+            four_at(&row[a * NY].m) += fma4(splat(wb), Ua[a], wdb * Va[a]);
             row[a * NY].vy0 += fma1(wb, u[a], wdb * v[a]);
           }
         }
