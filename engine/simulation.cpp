@@ -1433,7 +1433,9 @@ void Simulation::reorder_particles() {
 namespace {
 
 constexpr char kCheckpointMagic[8] = {'F', 'U', 'R', 'R', 'O', 'W', 'C', 'K'};
-constexpr uint32_t kCheckpointVersion = 1;
+// 2: node-indexed state (cell-fraction contact marks, particle contacts' stencil base) in the
+// column-major node order; version 1 (row-major) is still read and renumbered.
+constexpr uint32_t kCheckpointVersion = 2;
 
 template <class T> void put(std::ostream& out, const T& v) {
   static_assert(std::is_trivially_destructible_v<T> && !std::is_pointer_v<T>);  // plain values (Eigen's fixed-size too)
@@ -1492,8 +1494,9 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
   char magic[sizeof kCheckpointMagic];
   if (!in.read(magic, sizeof magic) || std::memcmp(magic, kCheckpointMagic, sizeof magic) != 0)
     r.fail("header", "not a Furrow checkpoint");
-  if (const auto v = r.get<uint32_t>("version"); v != kCheckpointVersion)
-    r.fail("version", std::to_string(v) + ", this build reads " + std::to_string(kCheckpointVersion));
+  const auto version = r.get<uint32_t>("version");
+  if (version != kCheckpointVersion && version != 1)
+    r.fail("version", std::to_string(version) + ", this build reads 1 and " + std::to_string(kCheckpointVersion));
   const uint64_t n = r.get<uint64_t>("particle count");
   if (n != p_.size())
     r.fail("particle count", std::to_string(n) + " points where this scene seeds " + std::to_string(p_.size()));
@@ -1519,6 +1522,16 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
   r.get_vector(contacts_, "contact points");
   for (const auto& c : contacts_)
     if (c.particle >= p_.size() || c.body >= bodies_.size()) r.fail("contact points", "a point out of range");
+  if (version == 1) {
+    // written with row-major nodes: the node k = j NX + i is now i NY + j
+    const size_t NX = size_t(g_.NX), NY = size_t(g_.NY);
+    auto column_major = [&](size_t k) { return (k % NX) * NY + k / NX; };
+    for (auto& t : touched_) {
+      std::vector<uint8_t> by_row = t;
+      for (size_t k = 0; k < by_row.size(); ++k) t[column_major(k)] = by_row[k];
+    }
+    for (auto& c : contacts_) c.base = column_major(c.base);
+  }
   if (in.peek() != std::char_traits<char>::eof()) r.fail("end", "data after the last item");
 }
 
