@@ -69,7 +69,7 @@ double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases) {
   }
   if (phases) {
     const PhaseSeconds& ph = sim.phase_seconds();
-    *phases = {ph.sort - before.sort,       ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
+    *phases = {ph.clear - before.clear,       ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
                ph.g2p - before.g2p,         ph.constitutive - before.constitutive,
                ph.reorder - before.reorder, ph.g2p_constitutive - before.g2p_constitutive};
   }
@@ -105,7 +105,7 @@ int bench_main(const Parsed& p) {
   const char* shape_names[] = {"linear", "quadratic", "cubic"};
   // G2P and the constitutive update run as one pass over the particles (one column)
   std::printf("%-10s %-5s %7s %19s   share of a step (%%): %5s %5s %5s %7s %9s %7s\n", "shape", "model", "threads",
-              "M particle-steps/s", "sort", "p2g", "grid", "contact", "g2p+const", "reorder");
+              "M particle-steps/s", "clear", "p2g", "grid", "contact", "g2p+const", "reorder");
   for (ShapeFunction shape : {ShapeFunction::Linear, ShapeFunction::Quadratic, ShapeFunction::Cubic})
     for (bool dpm : {false, true})
       for (int threads : thread_counts) {
@@ -117,7 +117,7 @@ int bench_main(const Parsed& p) {
         if (shape == ShapeFunction::Quadratic && !dpm && threads == thread_counts.back()) reference_rate = rate;
         auto share = [&](double phase) { return 100.0 * phase / ph.total(); };
         std::printf("%-10s %-5s %7d %19.2f   %21s %5.1f %5.1f %5.1f %7.1f %9.1f %7.1f\n", shape_names[int(shape)],
-                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.sort), share(ph.p2g), share(ph.grid),
+                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.clear), share(ph.p2g), share(ph.grid),
                     share(ph.contact), share(ph.g2p + ph.constitutive + ph.g2p_constitutive), share(ph.reorder));
         std::fflush(stdout);
       }
@@ -145,7 +145,7 @@ Command command_bench() {
           "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
           "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
-          "share of a step each phase takes (sort, P2G, grid update, body and wall contact, G2P with\n"
+          "share of a step each phase takes (grid clear, P2G, grid update, body and wall contact, G2P with\n"
           "the constitutive update (one pass), particle reorder); then quadratic NDPM on all cores at\n"
           "dx 1.25 mm (16 times the points) for how the rate falls on larger beds; and\n"
           "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"

@@ -481,9 +481,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   j["threads"] = scene.solver.threads > 0 ? scene.solver.threads : tbb::info::default_concurrency();
   j["peak_resident_bytes"] = peak_resident_bytes();
   const PhaseSeconds& ph = sim.phase_seconds();
-  j["phase_seconds"] = {{"sort", ph.sort}, {"p2g", ph.p2g}, {"grid", ph.grid}, {"contact", ph.contact},
+  j["phase_seconds"] = {{"clear", ph.clear}, {"p2g", ph.p2g}, {"grid", ph.grid}, {"contact", ph.contact},
                         {"g2p", ph.g2p}, {"constitutive", ph.constitutive},
                         {"g2p_constitutive", ph.g2p_constitutive}, {"reorder", ph.reorder}};
+  j["reorders"] = {{"scheduled", sim.reorders().scheduled}, {"strayed", sim.reorders().strayed},
+                   {"every_steps", Simulation::kReorderSteps}};
   j["state_bytes_per_particle"] = sim.particles().size() ? double(sim.state_bytes()) / sim.particles().size() : 0.0;
   j["state_precision"] = FURROW_FLOAT_STATE ? "float stress, pressure, mass, affine matrix, strain rate" : "double";
   j["frames"] = frame_index;

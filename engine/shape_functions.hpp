@@ -11,14 +11,16 @@ namespace furrow {
 struct LinearKernel {
   static constexpr int N = 1 + 1;
   static constexpr bool mls = false;  // APIC D is singular at nodes: use true gradients
+  // the first of the N node columns (or rows) a point at xg (in cells) reaches
+  static inline int base(double xg) { return int(std::floor(xg)); }
   static inline int weights(double xg, double w[N], double dw[N], double inv_dx) {
-    const int base = int(std::floor(xg));
-    const double f = xg - base;
+    const int b = base(xg);
+    const double f = xg - b;
     w[0] = 1.0 - f;
     w[1] = f;
     dw[0] = -inv_dx;
     dw[1] = inv_dx;
-    return base;
+    return b;
   }
   static double inv_D(double inv_dx) { return 0.0; }
 };
@@ -26,16 +28,17 @@ struct LinearKernel {
 struct QuadraticKernel {
   static constexpr int N = 3;
   static constexpr bool mls = true;
+  static inline int base(double xg) { return int(std::floor(xg - 0.5)); }
   static inline int weights(double xg, double w[N], double dw[N], double inv_dx) {
-    const int base = int(std::floor(xg - 0.5));
-    const double f = xg - base;  // in [0.5, 1.5)
+    const int b = base(xg);
+    const double f = xg - b;  // in [0.5, 1.5)
     w[0] = 0.5 * (1.5 - f) * (1.5 - f);
     w[1] = 0.75 - (f - 1.0) * (f - 1.0);
     w[2] = 0.5 * (f - 0.5) * (f - 0.5);
     dw[0] = (f - 1.5) * inv_dx;
     dw[1] = -2.0 * (f - 1.0) * inv_dx;
     dw[2] = (f - 0.5) * inv_dx;
-    return base;
+    return b;
   }
   static double inv_D(double inv_dx) { return 4.0 * inv_dx * inv_dx; }
 };
@@ -43,9 +46,10 @@ struct QuadraticKernel {
 struct CubicKernel {
   static constexpr int N = 4;
   static constexpr bool mls = true;
+  static inline int base(double xg) { return int(std::floor(xg)) - 1; }
   static inline int weights(double xg, double w[N], double dw[N], double inv_dx) {
-    const int base = int(std::floor(xg)) - 1;
-    const double f = xg - base;  // in [1, 2)
+    const int b = base(xg);
+    const double f = xg - b;  // in [1, 2)
     for (int k = 0; k < N; ++k) {
       const double d = f - k;  // particle minus node, in cells
       const double a = std::fabs(d), s = d >= 0 ? 1.0 : -1.0;
@@ -61,7 +65,7 @@ struct CubicKernel {
         dw[k] = 0.0;
       }
     }
-    return base;
+    return b;
   }
   static double inv_D(double inv_dx) { return 3.0 * inv_dx * inv_dx; }
 };

@@ -66,6 +66,9 @@ inline Vec4d fma4(const Vec4d& a, const Vec4d& b, const Vec4d& c) {
 #endif
 }
 inline Vec4d splat(double v) { return Vec4d{v, v, v, v}; }
+#if defined(__AVX__)
+inline Vec4d lane(const Vec4d& v, int l) { return (Vec4d)_mm256_broadcast_sd(&v[l]); }  // v[l] in every lane
+#endif
 inline double fma1(double a, double b, double c) {
 #if defined(__FMA__)
   return std::fma(a, b, c);
@@ -79,9 +82,7 @@ typedef float Vec4f __attribute__((vector_size(16)));
 // Four consecutive values as doubles, and back (a float array rounds each once, as a scalar store).
 template <class T> inline Vec4d load4(const T* a) {
   if constexpr (std::is_same_v<T, float>) {
-    Vec4f f;
-    std::memcpy(&f, a, sizeof f);
-    return __builtin_convertvector(f, Vec4d);
+    return (Vec4d)_mm256_cvtps_pd(_mm_loadu_ps(a));  // one instruction; GCC splits __builtin_convertvector in two
   } else {
     Vec4d v;
     std::memcpy(&v, a, sizeof v);
@@ -111,10 +112,18 @@ inline Vec4d quadratic_weights_by_four(const Vec4d& x_m, double inv_dx, Vec4d w[
 }
 #endif
 
-// The P2G strip of `cells` cell columns holding x; strip 0 and the last take the grid margins.
-inline int strip_index(double x_m, double inv_dx, int cells, int strips) {
-  return std::clamp(int(std::floor(x_m * inv_dx)) / cells + 1, 0, strips - 1);
-}
+// P2G's strips. A point whose stencil starts at node column `base` (the kernel's) belongs, when the
+// points are reordered, to strip s = floor(base / width) + 1: its nominal bases are
+// [width (s - 1), width s - 1]. Until the next reorder it may stray one column either way: its
+// window of bases [width (s - 1) - 1, width s] writes node columns up to width s + N - 1, which stay
+// left of what strip s + 2's window writes (width (s + 1) - 1) for width > N. So strips of one
+// colour never share a node, and P2G scatters a colour's strips in parallel without sorting.
+template <class K> struct StripWindow {
+  static constexpr int width = K::N + 1 > 4 ? K::N + 1 : 4;  // 4 node columns, 5 for cubic
+  static int count(int nx) { return nx / width + 3; }
+  static int of_base(int base, int strips) { return std::clamp((base + width) / width, 0, strips - 1); }  // base >= -2
+  static bool holds(int strip, int base) { return unsigned(base - (width * (strip - 1) - 1)) <= unsigned(width + 1); }
+};
 
 // The grid nodes a body's box covers, one node of margin, clipped to the padded grid. One
 // function for every contact pass, so a node one pass marks is a node another pass visits.
@@ -128,10 +137,13 @@ inline NodeBox body_node_box(const BodyState& s, const Grid& g) {
           std::max(-Grid::kPad, int(std::floor(lo.y())) - 1), std::min(g.ny + Grid::kPad, int(std::ceil(hi.y())) + 1)};
 }
 
-// The first and last P2G strips holding points within `reach_m` of a body's box.
-inline std::pair<int, int> body_strip_span(const BodyState& s, double reach_m, double inv_dx, int cells, int strips) {
-  return {strip_index(s.position_m.x() + s.lo_m.x() - reach_m, inv_dx, cells, strips),
-          strip_index(s.position_m.x() + s.hi_m.x() + reach_m, inv_dx, cells, strips)};
+// The first and last P2G strips whose points may lie within `reach_m` of a body's box: a strip
+// either side more than the points there now, since a point may have strayed from its strip.
+template <class K> inline std::pair<int, int> body_strip_span(const BodyState& s, double reach_m, double inv_dx, int strips) {
+  using W = StripWindow<K>;
+  const int first = W::of_base(K::base((s.position_m.x() + s.lo_m.x() - reach_m) * inv_dx), strips);
+  const int last = W::of_base(K::base((s.position_m.x() + s.hi_m.x() + reach_m) * inv_dx), strips);
+  return {std::max(first - 1, 0), std::min(last + 1, strips - 1)};
 }
 
 }  // namespace
@@ -146,7 +158,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   g_.nx = int(std::ceil(d.width_m / d.dx_m - 1e-9));
   g_.ny = int(std::ceil(d.height_m / d.dx_m - 1e-9));
   g_.NX = g_.nx + 1 + 2 * Grid::kPad;
-  if (g_.nx / kStripCells + 3 > 65535)  // the sort keeps each point's strip in 16 bits
+  if (StripWindow<QuadraticKernel>::count(g_.nx) > 65535)  // each point's home strip is kept in 16 bits
     throw std::invalid_argument("domain too wide: at most 262,000 cells across");
   g_.NY = g_.ny + 1 + 2 * Grid::kPad;
   const size_t nodes = size_t(g_.NX) * g_.NY;
@@ -183,6 +195,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
       case ContactMethod::CellFraction: contact_ = &Simulation::contact_cell_fraction<K>; break;
     }
     g2p_range_ = flip_ ? &Simulation::g2p_range<K, true> : &Simulation::g2p_range<K, false>;
+    reorder_ = &Simulation::reorder_particles<K>;
   };
   switch (scene_.solver.shape_function) {
     case ShapeFunction::Linear: pick(LinearKernel{}); break;
@@ -202,7 +215,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
   else pick_law(std::false_type{});
   const int threads = scene_.solver.threads > 0 ? scene_.solver.threads : tbb::task_arena::automatic;
   arena_ = std::make_unique<tbb::task_arena>(threads);
-  reorder_particles();
+  (this->*reorder_)();
 }
 
 Simulation::~Simulation() = default;
@@ -311,10 +324,10 @@ void Simulation::step() {
     mark = now;
   };
   dt_s_ = next_dt_s();
+  if (homes_stale_) arena_->execute([&] { (this->*reorder_)(); });
   arena_->execute([&] {
     clear_grid();
-    sort_particles();
-    lap(phase_s_.sort);
+    lap(phase_s_.clear);
     (this->*p2g_)();
     lap(phase_s_.p2g);
     grid_update();
@@ -339,8 +352,10 @@ void Simulation::step() {
   advance_bodies();
   t_s_ += dt_s_;
   ++steps_;
-  if (steps_ % 16 == 0) {
-    arena_->execute([&] { reorder_particles(); });
+  // now and then for memory order; at once when a point strayed from its strip's window
+  if (steps_ % kReorderSteps == 0 || strayed_) {
+    ++(strayed_ && steps_ % kReorderSteps != 0 ? reorders_.strayed : reorders_.scheduled);
+    arena_->execute([&] { (this->*reorder_)(); });
     lap(phase_s_.reorder);
   }
 }
@@ -363,45 +378,6 @@ void Simulation::clear_grid() {
   });
 }
 
-// Counting sort of particle indices by strip of kStripCells cell columns, in fixed chunks so it
-// runs on every core yet gives the serial order (by strip, then index) for any thread count.
-void Simulation::sort_particles() {
-  const size_t n = p_.size();
-  const int strips = g_.nx / kStripCells + 3;
-  constexpr size_t kChunks = 64;
-  const size_t chunk = (n + kChunks - 1) / kChunks;
-  chunk_counts_.assign(kChunks * size_t(strips), 0);  // [chunk][strip]
-  const double inv = 1.0 / g_.dx;
-  strip_of_.resize(n);
-  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
-    uint32_t* count = &chunk_counts_[c * size_t(strips)];
-    for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i) {
-      const int s = strip_index(p_.x[i], inv, kStripCells, strips);
-      strip_of_[i] = uint16_t(s);
-      ++count[s];
-    }
-  });
-  // exclusive prefix over (strip, chunk): each chunk's first slot within each strip
-  strip_start_.assign(strips + 1, 0);
-  uint32_t total = 0;
-  for (int s = 0; s < strips; ++s) {
-    strip_start_[s] = total;
-    for (size_t c = 0; c < kChunks; ++c) {
-      uint32_t& slot = chunk_counts_[c * size_t(strips) + size_t(s)];
-      const uint32_t k = slot;
-      slot = total;
-      total += k;
-    }
-  }
-  strip_start_[strips] = total;
-  order_.resize(n);
-  tbb::parallel_for(size_t(0), kChunks, [&](size_t c) {
-    uint32_t* fill = &chunk_counts_[c * size_t(strips)];
-    for (size_t i = c * chunk, end = std::min(n, i + chunk); i < end; ++i)
-      order_[fill[strip_of_[i]]++] = uint32_t(i);
-  });
-}
-
 template <class K, bool Flip>
 void Simulation::particles_to_grid() {
   const double dx = g_.dx, inv_dx = 1.0 / dx, dt = dt_s_;
@@ -412,15 +388,13 @@ void Simulation::particles_to_grid() {
     // locals, not captures: the grid stores below cannot change them, so they stay in registers
     GridNode* const nodes = grid;
     const size_t NY = size_t(g_.NY);
-    const uint32_t* const order = order_.data();
     const double *const X = P.x.data(), *const Y = P.y.data(), *const VX = P.vx.data(), *const VY = P.vy.data();
     const auto *const C00 = P.c00.data(), *const C01 = P.c01.data(), *const C10 = P.c10.data(), *const C11 = P.c11.data();
     const auto *const M = P.mass.data(), *const SXX = P.sxx.data(), *const SYY = P.syy.data(), *const SXY = P.sxy.data();
     const auto *const PRESSURE = P.pressure.data();
     const double* const VOL = P.volume.data();
     const double h = dx, ih = inv_dx, dt_ = dt, Dinv_ = Dinv;
-    for (uint32_t k = strip_start_[s], k_end = strip_start_[s + 1]; k < k_end; ++k) {
-      const uint32_t p = order[k];
+    for (uint32_t p = strip_start_[s], p_end = strip_start_[s + 1]; p < p_end; ++p) {
       double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
       const double xp = X[p], yp = Y[p];
       const int bx = K::weights(xp * ih, wx, dwx, ih);
@@ -534,16 +508,18 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
   const double h = g_.dx, ih = 1.0 / h, dt = dt_s_, Dinv = QuadraticKernel::inv_D(ih);
   GridNode* const nodes = g_.node.data();
   const size_t NY = size_t(g_.NY);
-  const uint32_t* const order = order_.data();
   const Particles& P = p_;
   const V zero = {0, 0, 0, 0};
-  const uint32_t k0 = strip_start_[size_t(strip)], k1 = strip_start_[size_t(strip) + 1];
-  for (uint32_t k = k0; k < k1; k += 4) {
-    // a strip's last group fills its empty lanes with its last point and scatters only the real ones
-    const uint32_t count = std::min<uint32_t>(4, k1 - k);
-    uint32_t idx[4];
-    for (uint32_t l = 0; l < 4; ++l) idx[l] = order[k + std::min(l, count - 1)];
-    auto gather = [&](const auto& a) { return V{double(a[idx[0]]), double(a[idx[1]]), double(a[idx[2]]), double(a[idx[3]])}; };
+  // points k..k+3 of the strip; count: a std::integral_constant 4 for a full group (plain loads),
+  // a size_t for the strip's last, whose empty lanes take its last point and scatter nothing.
+  // Inlined, so the grid's address and stride stay in registers across the scatter's stores.
+  auto group = [&](const uint32_t k, const auto count) __attribute__((always_inline)) {
+    auto gather = [&](const auto& a) {
+      if (count == 4) return load4(a.data() + k);
+      V v;
+      for (size_t l = 0; l < 4; ++l) v[l] = double(a[k + std::min(l, size_t(count) - 1)]);
+      return v;
+    };
     const V xp = gather(P.x), yp = gather(P.y);
     V wx[3], wy[3];
     int bx[4], by[4];
@@ -572,11 +548,11 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
       transpose4(wx[a] * zero, wx[a] * q01, wx[a] * q11, wx[a] * s01, Va[a]);
       for (int b = 0; b < 3; ++b) fifth[a][b] = fma4(wy[b], u[a], wdy[b] * v[a]);
     }
-    for (uint32_t l = 0; l < count; ++l) {
+    for (size_t l = 0; l < count; ++l) {
       GridNode* const column0 = nodes + Grid::index(bx[l], by[l], NY);
       GridNode* const column[3] = {column0, column0 + NY, column0 + 2 * NY};
       for (int b = 0; b < 3; ++b) {
-        const V wb = (V)_mm256_broadcast_sd(&wy[b][l]), wdb = (V)_mm256_broadcast_sd(&wdy[b][l]);
+        const V wb = lane(wy[b], int(l)), wdb = lane(wdy[b], int(l));
         for (int a = 0; a < 3; ++a) {
           GridNode& n = column[a][b];
           four_at(&n.m) += fma4(wb, Ua[a][l], wdb * Va[a][l]);
@@ -584,7 +560,11 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
         }
       }
     }
-  }
+  };
+  const uint32_t k0 = strip_start_[size_t(strip)], k1 = strip_start_[size_t(strip) + 1];
+  uint32_t k = k0;
+  for (; k + 4 <= k1; k += 4) group(k, std::integral_constant<size_t, 4>());
+  if (k < k1) group(k, size_t(k1 - k));
 #else
   (void)strip;
 #endif
@@ -726,9 +706,8 @@ void Simulation::contact_cell_fraction() {
     touched.resize(g_.node.size(), 0);
     // only nodes contact_nodes() visits are marked, so it also clears every mark it leaves behind
     const auto [i0, i1, j0, j1] = body_node_box(s, g_);
-    const auto [first, last] = body_strip_span(s, reach, inv_dx, kStripCells, strips);
-    for (uint32_t k = strip_start_[first]; k < strip_start_[last + 1]; ++k) {
-      const uint32_t p = order_[k];
+    const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
+    for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
       const Vec2 q = Vec2(p_.x[p], p_.y[p]) - s.position_m;
       if (q.y() < s.lo_m.y() - reach || q.y() > s.hi_m.y() + reach) continue;
       if (shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) > kTouchCells * dx) continue;
@@ -774,7 +753,7 @@ void Simulation::find_contact_points() {
   const size_t nb = bodies_.size();
   const auto& P = p_;
   // candidates: points within two cells of a body's box (no point moves a cell in a step), found
-  // in the strips of sort_particles() that the box spans, then put in (particle, body) order so
+  // in the strips whose points may lie there (body_strip_span), then put in (particle, body) order so
   // the list is the same for any thread count
   const double reach = 2.0 * dx;
   const int strips = int(strip_start_.size()) - 1;
@@ -782,7 +761,7 @@ void Simulation::find_contact_points() {
   std::vector<std::pair<int, int>> spans(nb);
   for (size_t b = 0; b < nb; ++b) {
     const BodyState& s = bodies_[b];
-    spans[b] = body_strip_span(s, reach, inv_dx, kStripCells, strips);
+    spans[b] = body_strip_span<K>(s, reach, inv_dx, strips);
   }
   tbb::parallel_for(size_t(0), contact_chunks_.size(), [&](size_t k) {
     const size_t b = k / size_t(strips);
@@ -791,8 +770,7 @@ void Simulation::find_contact_points() {
     out.clear();
     if (strip < spans[b].first || strip > spans[b].second) return;
     const BodyState& s = bodies_[b];
-    for (uint32_t i = strip_start_[strip]; i < strip_start_[strip + 1]; ++i) {
-      const uint32_t p = order_[i];
+    for (uint32_t p = strip_start_[strip]; p < strip_start_[strip + 1]; ++p) {
       const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
       if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
           q.y() > s.hi_m.y() + reach)
@@ -1031,6 +1009,7 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
           hy = zero + (scene_.domain.height_m + dx);
   auto& P = p_;
   double *const X = P.x.data(), *const Y = P.y.data(), *const VX = P.vx.data(), *const VY = P.vy.data();
+  const uint16_t* const home = home_strip_.data();
 
   // count: a std::integral_constant 4 for a full group (compiled apart: no lane tests), a size_t
   // for the last
@@ -1056,7 +1035,6 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     }
     // the gather of [vx vy vx0 vy0], as in g2p_range: per row R = sum wx g, S = sum wx dxp g
     V vel[4], ax[4], ay[4];
-    auto lane = [](const V& v, int l) { return (V)_mm256_broadcast_sd(&v[l]); };
     for (int l = 0; l < 4; ++l) {
       V vl = zero, axl = zero, ayl = zero;
       const GridNode* const column0 = grid + Grid::index(bx[l], by[l], NY);
@@ -1108,8 +1086,25 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     store(Y, y);
     store(VX, ux);
     store(VY, uy);
-    const V speed2 = ux * ux + uy * uy;
+    const V speed2 = fma4(ux, ux, uy * uy);  // as g2p_range's: the largest sets the next dt
     for (size_t l = 0; l < count; ++l) loc.vmax2 = std::max(loc.vmax2, speed2[l]);
+    // the next P2G's stencil base, by its own arithmetic: still in the point's strip window?
+    // (StripWindow::holds for the four lanes)
+    V wn[3];
+    int unused[4];
+    const __m128i base = _mm256_cvttpd_epi32((__m256d)quadratic_weights_by_four(x, ih, wn, unused));
+    __m128i strip;
+    if (count == 4) {
+      strip = _mm_cvtepu16_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(home + p)));
+    } else {
+      int h[4];
+      for (size_t l = 0; l < 4; ++l) h[l] = home[p + std::min(l, size_t(count) - 1)];
+      strip = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));
+    }
+    constexpr int w = StripWindow<QuadraticKernel>::width;
+    const __m128i first = _mm_sub_epi32(_mm_mullo_epi32(strip, _mm_set1_epi32(w)), _mm_set1_epi32(w + 1));
+    const __m128i offset = _mm_sub_epi32(base, first), last = _mm_set1_epi32(w + 1);
+    loc.strayed |= _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_max_epu32(offset, last), last)) != 0xffff;
   };
   size_t p = begin;
   for (; p + 4 <= end; p += 4) group(p, std::integral_constant<size_t, 4>());
@@ -1208,7 +1203,8 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
     P.y[p] = x.y();
     P.vx[p] = v.x();
     P.vy[p] = v.y();
-    loc.vmax2 = std::max(loc.vmax2, v.squaredNorm());
+    loc.vmax2 = std::max(loc.vmax2, fma1(v.x(), v.x(), v.y() * v.y()));  // as the four-wide path's
+    loc.strayed |= !StripWindow<K>::holds(home_strip_[p], K::base(x.x() * inv_dx));
   }
 }
 
@@ -1366,7 +1362,9 @@ void Simulation::particles_update(bool g2p, bool constitutive) {
   if (!g2p) return;
   stats_.projected_particles = 0;
   double vmax2 = 0.0;
+  strayed_ = false;
   for (const G2PLocal& loc : locals) {
+    strayed_ |= loc.strayed;
     for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m -= loc.impulse[b] / dt_s_;
     stats_.projected_particles += loc.projected;
     vmax2 = std::max(vmax2, loc.vmax2);
@@ -1383,22 +1381,28 @@ void Simulation::advance_bodies() {
   }
 }
 
-// Physically reorder particle arrays by cell (strip-major), so P2G and G2P walk memory in order.
+// Physically reorder particle arrays by strip, then by cell row and column within it, so P2G and
+// G2P walk memory in order and each strip's points are one range (strip_start_).
+template <class K>
 void Simulation::reorder_particles() {
+  using W = StripWindow<K>;
+  homes_stale_ = strayed_ = false;
   const size_t n = p_.size();
-  if (n == 0) return;
   const double inv = 1.0 / g_.dx;
-  const int rows = g_.ny + 2 * Grid::kPad + 1, cols = g_.nx + 2 * Grid::kPad + 1;
-  const size_t keys = size_t(rows) * cols;
-  std::vector<uint32_t> key(n), start(keys + 1, 0), perm(n);
+  const int strips = W::count(g_.nx), rows = g_.ny + 2 * Grid::kPad + 1;
+  const size_t strip_keys = size_t(rows) * W::width;
+  std::vector<uint32_t> key(n), start(size_t(strips) * strip_keys + 1, 0), perm(n);
   for (size_t i = 0; i < n; ++i) {
-    const int cx = std::clamp(int(std::floor(p_.x[i] * inv)) + Grid::kPad, 0, cols - 1);
+    const int base = K::base(p_.x[i] * inv), strip = W::of_base(base, strips);
+    const int column = std::clamp(base - W::width * (strip - 1), 0, W::width - 1);
     const int cy = std::clamp(int(std::floor(p_.y[i] * inv)) + Grid::kPad, 0, rows - 1);
-    const int strip = cx / kStripCells;
-    key[i] = uint32_t((size_t(strip) * rows + cy) * kStripCells + cx % kStripCells);
+    key[i] = uint32_t((size_t(strip) * rows + cy) * W::width + column);
     ++start[key[i] + 1];
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
+  strip_start_.resize(size_t(strips) + 1);
+  for (int s = 0; s <= strips; ++s) strip_start_[size_t(s)] = start[size_t(s) * strip_keys];
+  set_home_strips();
   for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);
   // the contact list (kept for the next step's warm start) follows its particles
   if (!contacts_.empty()) {
@@ -1430,12 +1434,36 @@ void Simulation::reorder_particles() {
   });
 }
 
+bool Simulation::strips_hold() const {
+  if (homes_stale_) return false;
+  const double inv_dx = 1.0 / g_.dx;
+  auto check = [&](auto kernel) {
+    using K = decltype(kernel);
+    for (size_t p = 0; p < p_.size(); ++p)
+      if (!StripWindow<K>::holds(home_strip_[p], K::base(p_.x[p] * inv_dx))) return false;
+    return true;
+  };
+  switch (scene_.solver.shape_function) {
+    case ShapeFunction::Linear: return check(LinearKernel{});
+    case ShapeFunction::Cubic: return check(CubicKernel{});
+    default: return check(QuadraticKernel{});
+  }
+}
+
+void Simulation::set_home_strips() {
+  home_strip_.resize(p_.size());
+  for (size_t s = 0; s + 1 < strip_start_.size(); ++s)
+    std::fill(home_strip_.begin() + strip_start_[s], home_strip_.begin() + strip_start_[s + 1], uint16_t(s));
+}
+
 namespace {
 
 constexpr char kCheckpointMagic[8] = {'F', 'U', 'R', 'R', 'O', 'W', 'C', 'K'};
 // 2: node-indexed state (cell-fraction contact marks, particle contacts' stencil base) in the
 // column-major node order; version 1 (row-major) is still read and renumbered.
-constexpr uint32_t kCheckpointVersion = 2;
+// 3: P2G's strip ranges (the points' home strips). Versions 1 and 2 are read and the points sorted
+// into strips again before the next step.
+constexpr uint32_t kCheckpointVersion = 3;
 
 template <class T> void put(std::ostream& out, const T& v) {
   static_assert(std::is_trivially_destructible_v<T> && !std::is_pointer_v<T>);  // plain values (Eigen's fixed-size too)
@@ -1487,6 +1515,8 @@ void Simulation::save_state(std::ostream& out) const {
   put(out, uint64_t(touched_.size()));
   for (const auto& t : touched_) put_vector(out, t);
   put_vector(out, contacts_);
+  put_vector(out, strip_start_);
+  put(out, reorders_);
 }
 
 void Simulation::load_state(std::istream& in, const std::string& what) {
@@ -1495,8 +1525,8 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
   if (!in.read(magic, sizeof magic) || std::memcmp(magic, kCheckpointMagic, sizeof magic) != 0)
     r.fail("header", "not a Furrow checkpoint");
   const auto version = r.get<uint32_t>("version");
-  if (version != kCheckpointVersion && version != 1)
-    r.fail("version", std::to_string(version) + ", this build reads 1 and " + std::to_string(kCheckpointVersion));
+  if (version < 1 || version > kCheckpointVersion)
+    r.fail("version", std::to_string(version) + ", this build reads 1 to " + std::to_string(kCheckpointVersion));
   const uint64_t n = r.get<uint64_t>("particle count");
   if (n != p_.size())
     r.fail("particle count", std::to_string(n) + " points where this scene seeds " + std::to_string(p_.size()));
@@ -1532,6 +1562,16 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
     }
     for (auto& c : contacts_) c.base = column_major(c.base);
   }
+  if (version >= 3) {
+    r.get_vector(strip_start_, "strip ranges", strip_start_.size());
+    for (size_t s = 0; s + 1 < strip_start_.size(); ++s)
+      if (strip_start_[s] > strip_start_[s + 1]) r.fail("strip ranges", "not in order");
+    if (strip_start_.front() != 0 || strip_start_.back() != p_.size()) r.fail("strip ranges", "do not cover the points");
+    set_home_strips();
+    reorders_ = r.get<Reorders>("reorder counts");
+  } else {
+    homes_stale_ = true;
+  }
   if (in.peek() != std::char_traits<char>::eof()) r.fail("end", "data after the last item");
 }
 
@@ -1539,8 +1579,7 @@ size_t Simulation::state_bytes() const {
   size_t b = 0;
   p_.for_each_array([&](const char*, const auto& a) { b += a.capacity() * sizeof(a[0]); });
   b += g_.node.capacity() * sizeof(GridNode);
-  b += (order_.capacity() + strip_start_.capacity() + chunk_counts_.capacity()) * sizeof(uint32_t);
-  b += strip_of_.capacity() * sizeof(uint16_t);
+  b += strip_start_.capacity() * sizeof(uint32_t) + home_strip_.capacity() * sizeof(uint16_t);
   return b;
 }
 

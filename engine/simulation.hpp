@@ -112,9 +112,9 @@ struct StepStats {
 // Wall-clock seconds spent in each phase of step(), summed over the run (for profiles: where a
 // step's time goes; they never feed back into the results).
 struct PhaseSeconds {
-  double sort = 0, p2g = 0, grid = 0, contact = 0, g2p = 0, constitutive = 0, reorder = 0;
+  double clear = 0, p2g = 0, grid = 0, contact = 0, g2p = 0, constitutive = 0, reorder = 0;
   double g2p_constitutive = 0;  // G2P and constitutive update fused into one pass (the default)
-  double total() const { return sort + p2g + grid + contact + g2p + constitutive + g2p_constitutive + reorder; }
+  double total() const { return clear + p2g + grid + contact + g2p + constitutive + g2p_constitutive + reorder; }
 };
 
 // A material point near a body's surface and its contact impulses (particle contact).
@@ -144,7 +144,11 @@ class Simulation {
 
   const Scene& scene() const { return scene_; }
   const Particles& particles() const { return p_; }
-  Particles& mutable_particles() { return p_; }  // tests and initial-condition tweaks only
+  // tests and initial-condition tweaks only; the next step sorts the points into strips again
+  Particles& mutable_particles() {
+    homes_stale_ = true;
+    return p_;
+  }
   const Grid& grid() const { return g_; }
   const std::vector<BodyState>& bodies() const { return bodies_; }
   // walls: reaction force on each wall in the last step (left, right, bottom, top)
@@ -155,6 +159,14 @@ class Simulation {
   double next_dt_s() const;
   const StepStats& stats() const { return stats_; }
   const PhaseSeconds& phase_seconds() const { return phase_s_; }
+  // reorders so far: on schedule (every kReorderSteps) and because a point strayed from its strip
+  struct Reorders {
+    int64_t scheduled = 0, strayed = 0;
+  };
+  const Reorders& reorders() const { return reorders_; }
+  static constexpr int kReorderSteps = 64;
+  // every point's stencil within its home strip's window (what P2G's race-free scatter needs)
+  bool strips_hold() const;
   // G2P and the constitutive update as one pass (default) or two (to time each; same results)
   void set_fused_particle_passes(bool fused) { fuse_particle_passes_ = fused; }
   // The default P2G and G2P and NDPM's update four points at a time (the default) or a point at
@@ -184,7 +196,6 @@ class Simulation {
   void seed_beds();
   void sample_body_fields();
   void clear_grid();
-  void sort_particles();
   template <class Kernel, bool Flip> void particles_to_grid();
   void grid_update();
   void bodies_and_walls();
@@ -200,6 +211,7 @@ class Simulation {
     std::vector<Vec2> impulse;  // per body: the safety net's projections
     int64_t projected = 0;
     double vmax2 = 0.0;
+    bool strayed = false;  // a point left its strip's window (the step ends with a reorder)
   };
   template <class Kernel, bool Flip> void g2p_range(size_t begin, size_t end, G2PLocal& loc);
   size_t g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc);
@@ -210,7 +222,8 @@ class Simulation {
   template <bool Dilatancy, bool Track> size_t constitutive_by_four(size_t begin, size_t end);
   void particles_update(bool g2p, bool constitutive);
   void advance_bodies();
-  void reorder_particles();
+  template <class Kernel> void reorder_particles();
+  void set_home_strips();
 
   Scene scene_;
   Particles p_;
@@ -226,11 +239,16 @@ class Simulation {
   bool dilatancy_ = false;
   bool flip_ = false;
   bool track_plastic_ = false;
-  // strips of kStripCells cell columns, processed in two colours so P2G scatters race-free
-  static constexpr int kStripCells = 4;
-  std::vector<uint32_t> order_, strip_start_;
-  std::vector<uint16_t> strip_of_;  // each point's strip, found by the sort's count pass for its fill pass
-  std::vector<uint32_t> chunk_counts_;
+  // P2G's strips (simulation.cpp, StripWindow): the reorder sorts the points by strip, strip s
+  // holding points [strip_start_[s], strip_start_[s + 1]) until the next reorder (each point's
+  // home strip, home_strip_), and P2G scatters each home strip in two colours without sorting
+  // again. G2P reports a point that strayed so far that two strips of a colour could share a node
+  // (strayed_) and the step then reorders.
+  std::vector<uint32_t> strip_start_;
+  std::vector<uint16_t> home_strip_;
+  bool strayed_ = false, homes_stale_ = false;
+  Reorders reorders_;
+  void (Simulation::*reorder_)() = nullptr;
   mutable std::vector<double> rho_g_cache_;
   void (Simulation::*p2g_)() = nullptr;
   void (Simulation::*g2p_range_)(size_t, size_t, G2PLocal&) = nullptr;
