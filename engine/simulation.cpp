@@ -1392,13 +1392,16 @@ void Simulation::reorder_particles() {
   const int strips = W::count(g_.nx), rows = g_.ny + 2 * Grid::kPad + 1;
   const size_t strip_keys = size_t(rows) * W::width;
   std::vector<uint32_t> key(n), start(size_t(strips) * strip_keys + 1, 0), perm(n);
-  for (size_t i = 0; i < n; ++i) {
-    const int base = K::base(p_.x[i] * inv), strip = W::of_base(base, strips);
-    const int column = std::clamp(base - W::width * (strip - 1), 0, W::width - 1);
-    const int cy = std::clamp(int(std::floor(p_.y[i] * inv)) + Grid::kPad, 0, rows - 1);
-    key[i] = uint32_t((size_t(strip) * rows + cy) * W::width + column);
-    ++start[key[i] + 1];
-  }
+  const tbb::blocked_range<size_t> all(0, n, size_t(1) << 14);
+  tbb::parallel_for(all, [&](const auto& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const int base = K::base(p_.x[i] * inv), strip = W::of_base(base, strips);
+      const int column = std::clamp(base - W::width * (strip - 1), 0, W::width - 1);
+      const int cy = std::clamp(int(std::floor(p_.y[i] * inv)) + Grid::kPad, 0, rows - 1);
+      key[i] = uint32_t((size_t(strip) * rows + cy) * W::width + column);
+    }
+  });
+  for (size_t i = 0; i < n; ++i) ++start[key[i] + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
   strip_start_.resize(size_t(strips) + 1);
   for (int s = 0; s <= strips; ++s) strip_start_[size_t(s)] = start[size_t(s) * strip_keys];
@@ -1417,7 +1420,6 @@ void Simulation::reorder_particles() {
   std::vector<double> buffer_f64;
   std::vector<float> buffer_f32;
   std::vector<uint8_t> buffer_u8;
-  const tbb::blocked_range<size_t> all(0, n, size_t(1) << 14);
   p_.for_each_array([&](const char*, auto& a) {
     using T = typename std::decay_t<decltype(a)>::value_type;
     if (a.empty()) return;
