@@ -69,7 +69,7 @@ double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases) {
   }
   if (phases) {
     const PhaseSeconds& ph = sim.phase_seconds();
-    *phases = {ph.clear - before.clear,       ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
+    *phases = {ph.clear - before.clear,     ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
                ph.g2p - before.g2p,         ph.constitutive - before.constitutive,
                ph.reorder - before.reorder, ph.g2p_constitutive - before.g2p_constitutive};
   }
