@@ -123,6 +123,14 @@ template <class K> struct StripWindow {
   static int count(int nx) { return nx / width + 3; }
   static int of_base(int base, int strips) { return std::clamp((base + width) / width, 0, strips - 1); }  // base >= -2
   static bool holds(int strip, int base) { return unsigned(base - (width * (strip - 1) - 1)) <= unsigned(width + 1); }
+#if defined(__AVX__)
+  // holds() for four points at once (strips and bases as 32-bit lanes): true when all four hold
+  static bool holds4(__m128i strip, __m128i base) {
+    const __m128i first = _mm_sub_epi32(_mm_mullo_epi32(strip, _mm_set1_epi32(width)), _mm_set1_epi32(width + 1));
+    const __m128i offset = _mm_sub_epi32(base, first), last = _mm_set1_epi32(width + 1);
+    return _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_max_epu32(offset, last), last)) == 0xffff;
+  }
+#endif
 };
 
 // The grid nodes a body's box covers, one node of margin, clipped to the padded grid. One
@@ -196,6 +204,7 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     }
     g2p_range_ = flip_ ? &Simulation::g2p_range<K, true> : &Simulation::g2p_range<K, false>;
     reorder_ = &Simulation::reorder_particles<K>;
+    strips_hold_ = &Simulation::strips_hold_for<K>;
   };
   switch (scene_.solver.shape_function) {
     case ShapeFunction::Linear: pick(LinearKernel{}); break;
@@ -1089,7 +1098,6 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     const V speed2 = fma4(ux, ux, uy * uy);  // as g2p_range's: the largest sets the next dt
     for (size_t l = 0; l < count; ++l) loc.vmax2 = std::max(loc.vmax2, speed2[l]);
     // the next P2G's stencil base, by its own arithmetic: still in the point's strip window?
-    // (StripWindow::holds for the four lanes)
     V wn[3];
     int unused[4];
     const __m128i base = _mm256_cvttpd_epi32((__m256d)quadratic_weights_by_four(x, ih, wn, unused));
@@ -1101,10 +1109,7 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
       for (size_t l = 0; l < 4; ++l) h[l] = home[p + std::min(l, size_t(count) - 1)];
       strip = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));
     }
-    constexpr int w = StripWindow<QuadraticKernel>::width;
-    const __m128i first = _mm_sub_epi32(_mm_mullo_epi32(strip, _mm_set1_epi32(w)), _mm_set1_epi32(w + 1));
-    const __m128i offset = _mm_sub_epi32(base, first), last = _mm_set1_epi32(w + 1);
-    loc.strayed |= _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_max_epu32(offset, last), last)) != 0xffff;
+    loc.strayed |= !StripWindow<QuadraticKernel>::holds4(strip, base);
   };
   size_t p = begin;
   for (; p + 4 <= end; p += 4) group(p, std::integral_constant<size_t, 4>());
@@ -1436,20 +1441,13 @@ void Simulation::reorder_particles() {
   });
 }
 
-bool Simulation::strips_hold() const {
+template <class K>
+bool Simulation::strips_hold_for() const {
   if (homes_stale_) return false;
   const double inv_dx = 1.0 / g_.dx;
-  auto check = [&](auto kernel) {
-    using K = decltype(kernel);
-    for (size_t p = 0; p < p_.size(); ++p)
-      if (!StripWindow<K>::holds(home_strip_[p], K::base(p_.x[p] * inv_dx))) return false;
-    return true;
-  };
-  switch (scene_.solver.shape_function) {
-    case ShapeFunction::Linear: return check(LinearKernel{});
-    case ShapeFunction::Cubic: return check(CubicKernel{});
-    default: return check(QuadraticKernel{});
-  }
+  for (size_t p = 0; p < p_.size(); ++p)
+    if (!StripWindow<K>::holds(home_strip_[p], K::base(p_.x[p] * inv_dx))) return false;
+  return true;
 }
 
 void Simulation::set_home_strips() {

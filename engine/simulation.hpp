@@ -166,7 +166,7 @@ class Simulation {
   const Reorders& reorders() const { return reorders_; }
   static constexpr int kReorderSteps = 64;
   // every point's stencil within its home strip's window (what P2G's race-free scatter needs)
-  bool strips_hold() const;
+  bool strips_hold() const { return (this->*strips_hold_)(); }
   // G2P and the constitutive update as one pass (default) or two (to time each; same results)
   void set_fused_particle_passes(bool fused) { fuse_particle_passes_ = fused; }
   // The default P2G and G2P and NDPM's update four points at a time (the default) or a point at
@@ -249,6 +249,8 @@ class Simulation {
   bool strayed_ = false, homes_stale_ = false;
   Reorders reorders_;
   void (Simulation::*reorder_)() = nullptr;
+  template <class Kernel> bool strips_hold_for() const;
+  bool (Simulation::*strips_hold_)() const = nullptr;
   mutable std::vector<double> rho_g_cache_;
   void (Simulation::*p2g_)() = nullptr;
   void (Simulation::*g2p_range_)(size_t, size_t, G2PLocal&) = nullptr;
