@@ -1,7 +1,6 @@
 #include "engine/simulation.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -1354,13 +1353,15 @@ void Simulation::constitutive_range(size_t begin, size_t end) {
 // (the same arithmetic, so the same bits; no faster on its own, README); apart
 // when the front/back walls' friction must act between them, or for a profile of each phase.
 void Simulation::particles_update(bool g2p, bool constitutive) {
-  const size_t nb = bodies_.size();
-  tbb::enumerable_thread_specific<G2PLocal> locals([&] { return G2PLocal{std::vector<Vec2>(nb, Vec2(0, 0))}; });
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, p_.size(), kGrain), [&](const auto& r) {
-    G2PLocal* loc = g2p ? &locals.local() : nullptr;  // the constitutive-only pass makes none
-    for (size_t b = r.begin(); b < r.end(); b += kFusedBlock) {
-      const size_t e = std::min(r.end(), b + kFusedBlock);
-      if (g2p) (this->*g2p_range_)(b, e, *loc);
+  const size_t nb = bodies_.size(), chunks = (p_.size() + kGrain - 1) / kGrain;
+  // one G2P tally per fixed chunk, summed in order: the bodies' forces then have the same bits
+  // for any thread count (per-thread tallies did not, wherever the safety net acted)
+  std::vector<G2PLocal> locals(g2p ? chunks : 0, G2PLocal{std::vector<Vec2>(nb, Vec2(0, 0))});
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    const size_t begin = c * kGrain, end = std::min(p_.size(), begin + kGrain);
+    for (size_t b = begin; b < end; b += kFusedBlock) {
+      const size_t e = std::min(end, b + kFusedBlock);
+      if (g2p) (this->*g2p_range_)(b, e, locals[c]);
       if (constitutive) (this->*constitutive_range_)(b, e);
     }
   });
