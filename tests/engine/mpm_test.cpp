@@ -146,12 +146,14 @@ TEST(Mpm, OneAndTwoThreadsGiveIdenticalResults) {
     Simulation a(s);
     s.solver.threads = 2;
     Simulation b(s);
+    int steps_differ = 0;  // every step's force, not only the last one's
     for (int k = 0; k < 300; ++k) {
       a.step();
       b.step();
+      steps_differ += a.bodies()[0].force_N_per_m != b.bodies()[0].force_N_per_m;
     }
     EXPECT_NE(a.bodies()[0].force_N_per_m.y(), 0.0);
-    EXPECT_EQ(a.bodies()[0].force_N_per_m, b.bodies()[0].force_N_per_m);
+    EXPECT_EQ(steps_differ, 0) << contact_method_name(contact);
     EXPECT_EQ(a.particles().x, b.particles().x);
     EXPECT_EQ(a.particles().pressure, b.particles().pressure);
   }
