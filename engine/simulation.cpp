@@ -31,10 +31,13 @@ constexpr size_t kGrain = 4096;  // particles per TBB task
 // Performance); it is the shape a fused G2P + constitutive + next P2G pass would take.
 constexpr size_t kFusedBlock = 256;
 // cell-fraction contact: the body as its own mass field (see contact_nodes). Its sample points
-// fill the body deeper than kBodyFieldInset cells, kBodySamplesPerCell per cell and axis, each
-// with kBodyDensityRatio times the bed's mean density. All three were chosen by measurement
-// (README, "Body contact").
+// fill the body deeper than kBodyFieldInset cells, and deeper than kBodyFieldSideInset cells
+// across the body's motion (its faces along the motion, which never cross node lines, need no
+// smooth reach, and a field reaching past them made the body act wider: README, "Body
+// contact"), kBodySamplesPerCell per cell and axis, each with kBodyDensityRatio times the bed's
+// mean density. All four were chosen by measurement.
 constexpr double kBodyFieldInset = 0.5;
+constexpr double kBodyFieldSideInset = 1.0;
 constexpr int kBodySamplesPerCell = 4;
 constexpr double kBodyDensityRatio = 20.0;
 // cell-fraction contact starts where a point's surface comes this close to a body, in cells (the
@@ -151,6 +154,19 @@ template <class K> inline std::pair<int, int> body_strip_span(const BodyState& s
   const int first = W::of_base(K::base((s.position_m.x() + s.lo_m.x() - reach_m) * inv_dx), strips);
   const int last = W::of_base(K::base((s.position_m.x() + s.hi_m.x() + reach_m) * inv_dx), strips);
   return {std::max(first - 1, 0), std::min(last + 1, strips - 1)};
+}
+
+// The unit vector across a body's motion (its first nonzero velocity turned a quarter), or zero
+// for a body that never moves. A path that turns keeps its first direction's.
+inline Vec2 across_motion(const Motion& m) {
+  Vec2 v = m.velocity_m_s;
+  if (m.kind == Motion::Kind::Path)
+    for (const auto& knot : m.path)
+      if (knot.velocity_m_s.squaredNorm() > 0.0) {
+        v = knot.velocity_m_s;
+        break;
+      }
+  return v.squaredNorm() > 0.0 ? Vec2(-v.y(), v.x()).normalized() : Vec2(0.0, 0.0);
 }
 
 }  // namespace
@@ -315,9 +331,31 @@ void Simulation::sample_body_fields() {
         deepest = std::max(deepest, depth);
       }
     const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
+    const Shape& shape = scene_.bodies[b].shape;
+    const Vec2 across = across_motion(scene_.bodies[b].motion);
+    // distance from q to the surface along +-across (bisection on the SDF; the body is inside its box)
+    auto depth_across = [&](const Vec2& q) {
+      const double far = (s.hi_m - s.lo_m).norm();
+      double depth = far;
+      for (double sign : {-1.0, 1.0}) {
+        double in = 0.0, out = far;
+        for (int k = 0; k < 40; ++k) {
+          const double mid = 0.5 * (in + out);
+          (shape_sdf(shape, q + sign * mid * across) < 0.0 ? in : out) = mid;
+        }
+        depth = std::min(depth, out);
+      }
+      return depth;
+    };
+    std::vector<double> across_m(inside.size(), 0.0);
+    double widest = 0.0;
+    if (across.squaredNorm() > 0.0)
+      for (size_t k = 0; k < inside.size(); ++k) widest = std::max(widest, across_m[k] = depth_across(inside[k].first));
+    // as with the inset, a body too thin for it keeps its middle
+    const double side_inset = std::min(kBodyFieldSideInset * dx, 0.5 * widest);
     std::vector<Vec2> samples;
-    for (const auto& [q, depth] : inside)
-      if (depth >= inset) samples.push_back(q);
+    for (size_t k = 0; k < inside.size(); ++k)
+      if (inside[k].second >= inset && across_m[k] >= side_inset) samples.push_back(inside[k].first);
     body_samples_m_.push_back(std::move(samples));
   }
   body_sample_mass_kg_ = density * h * h;
@@ -648,14 +686,16 @@ void Simulation::bodies_and_walls() {
 // sample points fixed in its frame (contact_cell_fraction), and a node takes the share
 // m_body / (m_body + m_media) of the correction, as multi-field contact of the media against a
 // body of finite mass would (Bardenhagen et al. 2001). The share is a smooth function of the
-// body's position, so no node switches on at once as a face crosses a node line. Its normal is
-// the media's mass gradient: the body's own nearest-face normal flips at its medial axis, which
-// in a plate two cells thick is a node row that then stops holding the material below it (the
-// larger part of the node method's comb). Nodes act only once touched (contact_cell_fraction).
+// body's position, so no node switches on at once as a face crosses a node line. The correction
+// itself is the mass-weighted mean of what each media point in the node's stencil asks of it: the
+// node's velocity held against the body along that point's own face normal (Coulomb slip along
+// it). One normal per node flips where the node crosses a thin body's medial axis (a node row of
+// a plate two cells thick, which then stopped holding the material below it: the larger part of
+// the node method's comb, and of a mass-gradient normal's); the points' normals do not, since
+// each point stays on its own side. Nodes act only once touched (contact_cell_fraction).
 template <bool Fraction>
 void Simulation::contact_nodes() {
   const double dt = dt_s_, dx = g_.dx;
-  const int lo = -Grid::kPad, hi_i = g_.nx + Grid::kPad, hi_j = g_.ny + Grid::kPad;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const Body& body = scene_.bodies[b];
     BodyState& s = bodies_[b];
@@ -668,8 +708,9 @@ void Simulation::contact_nodes() {
         GridNode& n = g_.node[k];
         const Vec2 q = Vec2(i * dx, j * dx) - s.position_m;
         double share = 1.0;
+        const size_t c = size_t(j - j0) * size_t(i1 - i0 + 1) + size_t(i - i0);  // index in the body's box
         if constexpr (Fraction) {
-          const double m_body = body_node_mass_kg_[b][size_t(j - j0) * size_t(i1 - i0 + 1) + size_t(i - i0)];
+          const double m_body = body_node_mass_kg_[b][c];
           if (n.m <= 0.0 || m_body <= 0.0) {
             touched_[b][k] = 0;  // out of the body's reach: must be touched again
             continue;
@@ -679,16 +720,15 @@ void Simulation::contact_nodes() {
         } else if (n.m <= 0.0 || shape_sdf(body.shape, q) >= 0.0) {
           continue;
         }
-        Vec2 normal = shape_normal(body.shape, q, 1e-4 * dx);
-        if constexpr (Fraction) {
-          auto m = [&](int a, int c) { return g_.node[g_.index(std::clamp(a, lo, hi_i), std::clamp(c, lo, hi_j))].m; };
-          const Vec2 grad(m(i + 1, j) - m(i - 1, j), m(i, j + 1) - m(i, j - 1));
-          if (grad.squaredNorm() > 0.0) normal = grad.normalized();
-        }
         Vec2 v(n.vx, n.vy);
         const Vec2 before = v;
-        if (!contact(v, s.velocity_m_s, normal, mu)) continue;
-        if constexpr (Fraction) v = before + share * (v - before);
+        if constexpr (Fraction) {
+          const double m_points = stencil_mass_kg_[b][c];
+          if (m_points <= 0.0) continue;
+          v += share * (stencil_dv_kg_m_s_[b][c] / m_points);
+        } else if (!contact(v, s.velocity_m_s, shape_normal(body.shape, q, 1e-4 * dx), mu)) {
+          continue;
+        }
         impulse += n.m * (v - before);
         n.vx = v.x();
         n.vy = v.y();
@@ -703,32 +743,57 @@ void Simulation::contact_nodes() {
 // a cell from the surface and the body feels the bed before it meets it.
 template <class K>
 void Simulation::contact_cell_fraction() {
-  const double dx = g_.dx, inv_dx = 1.0 / dx, reach = 2.0 * dx;
+  const double dx = g_.dx, inv_dx = 1.0 / dx;
+  // a point reaches the nodes of the body's box (the body's box and two cells) from 1.5 cells out
+  const double reach = 3.5 * dx;
   const int strips = int(strip_start_.size()) - 1;
   touched_.resize(bodies_.size());
   body_node_mass_kg_.resize(bodies_.size());
+  stencil_dv_kg_m_s_.resize(bodies_.size());
+  stencil_mass_kg_.resize(bodies_.size());
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const BodyState& s = bodies_[b];
     const Shape& shape = scene_.bodies[b].shape;
+    const double mu = scene_.effects.body_friction ? scene_.bodies[b].friction : 0.0;
     auto& touched = touched_[b];
     touched.resize(g_.node.size(), 0);
     // only nodes contact_nodes() visits are marked, so it also clears every mark it leaves behind
     const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+    const size_t width = size_t(i1 - i0 + 1), box_nodes = width * size_t(j1 - j0 + 1);
+    auto& dv = stencil_dv_kg_m_s_[b];
+    auto& m_points = stencil_mass_kg_[b];
+    dv.assign(box_nodes, Vec2(0.0, 0.0));
+    m_points.assign(box_nodes, 0.0);
+    // each point in reach: marks its stencil if it touches the body, and adds to each node of its
+    // stencil (weight x mass) the change that holds the node against the body along the point's
+    // own face normal; points in strip order, so the sums are the same for any thread count
     const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
     for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
       const Vec2 q = Vec2(p_.x[p], p_.y[p]) - s.position_m;
-      if (q.y() < s.lo_m.y() - reach || q.y() > s.hi_m.y() + reach) continue;
-      if (shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) > kTouchCells * dx) continue;
-      double w[K::N], dw[K::N];
-      const int bx = K::weights(p_.x[p] * inv_dx, w, dw, inv_dx);
-      const int by = K::weights(p_.y[p] * inv_dx, w, dw, inv_dx);
+      if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
+          q.y() > s.hi_m.y() + reach)
+        continue;
+      double wx[K::N], wy[K::N], dw[K::N];
+      const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
+      const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
+      if (bx + K::N - 1 < i0 || bx > i1 || by + K::N - 1 < j0 || by > j1) continue;
+      const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
+      const Vec2 normal = shape_normal(shape, q, 1e-4 * dx);
+      const double mass = double(p_.mass[p]);
       for (int j = std::max(by, j0); j <= std::min(by + K::N - 1, j1); ++j)
-        for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i) touched[g_.index(i, j)] = 1;
+        for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i) {
+          const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
+          if (touching) touched[k] = 1;
+          const double wm = wx[i - bx] * wy[j - by] * mass;
+          m_points[c] += wm;
+          Vec2 v(g_.node[k].vx, g_.node[k].vy);
+          const Vec2 v0 = v;
+          if (contact(v, s.velocity_m_s, normal, mu)) dv[c] += wm * (v - v0);
+        }
     }
     // the body's field over its node box
-    const size_t width = size_t(i1 - i0 + 1);
     auto& field = body_node_mass_kg_[b];
-    field.assign(width * size_t(j1 - j0 + 1), 0.0);
+    field.assign(box_nodes, 0.0);
     for (const Vec2& q : body_samples_m_[b]) {
       const Vec2 x = s.position_m + q;
       double wx[K::N], wy[K::N], dw[K::N];

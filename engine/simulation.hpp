@@ -265,6 +265,10 @@ class Simulation {
   std::vector<std::vector<Vec2>> body_samples_m_;
   double body_sample_mass_kg_ = 0.0;
   std::vector<std::vector<double>> body_node_mass_kg_;
+  // cell-fraction contact, per body over its node box: the points' summed velocity changes (kg m/s)
+  // and the mass they came with (kg), both weighted by the points' weights
+  std::vector<std::vector<Vec2>> stencil_dv_kg_m_s_;
+  std::vector<std::vector<double>> stencil_mass_kg_;
   std::vector<std::vector<uint32_t>> contact_chunks_;
   std::unique_ptr<tbb::task_arena> arena_;
 };
