@@ -764,33 +764,6 @@ void Simulation::contact_cell_fraction() {
     auto& m_points = stencil_mass_kg_[b];
     dv.assign(box_nodes, Vec2(0.0, 0.0));
     m_points.assign(box_nodes, 0.0);
-    // each point in reach: marks its stencil if it touches the body, and adds to each node of its
-    // stencil (weight x mass) the change that holds the node against the body along the point's
-    // own face normal; points in strip order, so the sums are the same for any thread count
-    const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
-    for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
-      const Vec2 q = Vec2(p_.x[p], p_.y[p]) - s.position_m;
-      if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
-          q.y() > s.hi_m.y() + reach)
-        continue;
-      double wx[K::N], wy[K::N], dw[K::N];
-      const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
-      const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
-      if (bx + K::N - 1 < i0 || bx > i1 || by + K::N - 1 < j0 || by > j1) continue;
-      const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
-      const Vec2 normal = shape_normal(shape, q, 1e-4 * dx);
-      const double mass = double(p_.mass[p]);
-      for (int j = std::max(by, j0); j <= std::min(by + K::N - 1, j1); ++j)
-        for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i) {
-          const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
-          if (touching) touched[k] = 1;
-          const double wm = wx[i - bx] * wy[j - by] * mass;
-          m_points[c] += wm;
-          Vec2 v(g_.node[k].vx, g_.node[k].vy);
-          const Vec2 v0 = v;
-          if (contact(v, s.velocity_m_s, normal, mu)) dv[c] += wm * (v - v0);
-        }
-    }
     // the body's field over its node box
     auto& field = body_node_mass_kg_[b];
     field.assign(box_nodes, 0.0);
@@ -802,6 +775,40 @@ void Simulation::contact_cell_fraction() {
       for (int j = std::max(by, j0); j <= std::min(by + K::N - 1, j1); ++j)
         for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i)
           field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
+    }
+    // each point in reach: marks its stencil if it touches the body, and adds to each node of its
+    // stencil (weight x mass) the change that holds the node against the body along the point's
+    // own face normal; points in strip order, so the sums are the same for any thread count. Only
+    // nodes the body's field reaches: contact_nodes() acts on no other (and clears their marks).
+    const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
+    for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
+      const Vec2 q = Vec2(p_.x[p], p_.y[p]) - s.position_m;
+      if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
+          q.y() > s.hi_m.y() + reach)
+        continue;
+      double wx[K::N], wy[K::N], dw[K::N];
+      const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
+      const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
+      const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
+      const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
+      bool reached = false;
+      for (int j = ja; j <= jb; ++j)
+        for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
+      if (!reached) continue;
+      const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
+      const Vec2 normal = shape_normal(shape, q, 1e-4 * dx);
+      const double mass = double(p_.mass[p]);
+      for (int j = ja; j <= jb; ++j)
+        for (int i = ia; i <= ib; ++i) {
+          const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
+          if (field[c] <= 0.0) continue;
+          if (touching) touched[k] = 1;
+          const double wm = wx[i - bx] * wy[j - by] * mass;
+          m_points[c] += wm;
+          Vec2 v(g_.node[k].vx, g_.node[k].vy);
+          const Vec2 v0 = v;
+          if (contact(v, s.velocity_m_s, normal, mu)) dv[c] += wm * (v - v0);
+        }
     }
   }
   contact_nodes<true>();
