@@ -177,12 +177,17 @@ std::pair<Vec2, Vec2> shape_bounds_m(const Shape& shape) {
   return {lo + shape.offset_m, hi + shape.offset_m};
 }
 
+Vec2 travel_direction(const Scene& scene, const Body& body) {
+  const Vec2 v = motion_velocity_m_s(body.motion, 0.5 * estimate_end_time_s(scene));
+  return v.norm() > 0.0 ? Vec2(v / v.norm()) : Vec2(0.0, 0.0);
+}
+
 double body_cells_across(const Scene& scene, const Body& body) {
   const auto [lo, hi] = shape_bounds_m(body.shape);
   const Vec2 size = hi - lo;
-  const Vec2 v = motion_velocity_m_s(body.motion, 0.5 * estimate_end_time_s(scene));
-  const double across = v.norm() > 0.0 ? (std::abs(size.x() * v.y()) + std::abs(size.y() * v.x())) / v.norm()
-                                        : std::min(size.x(), size.y());
+  const Vec2 d = travel_direction(scene, body);
+  const double across = d.squaredNorm() > 0.0 ? std::abs(size.x() * d.y()) + std::abs(size.y() * d.x())
+                                              : std::min(size.x(), size.y());
   return across / scene.domain.dx_m;
 }
 

@@ -156,19 +156,6 @@ template <class K> inline std::pair<int, int> body_strip_span(const BodyState& s
   return {std::max(first - 1, 0), std::min(last + 1, strips - 1)};
 }
 
-// The unit vector across a body's motion (its first nonzero velocity turned a quarter), or zero
-// for a body that never moves. A path that turns keeps its first direction's.
-inline Vec2 across_motion(const Motion& m) {
-  Vec2 v = m.velocity_m_s;
-  if (m.kind == Motion::Kind::Path)
-    for (const auto& knot : m.path)
-      if (knot.velocity_m_s.squaredNorm() > 0.0) {
-        v = knot.velocity_m_s;
-        break;
-      }
-  return v.squaredNorm() > 0.0 ? Vec2(-v.y(), v.x()).normalized() : Vec2(0.0, 0.0);
-}
-
 }  // namespace
 
 Simulation::Simulation(const Scene& scene) : scene_(scene) {
@@ -332,7 +319,8 @@ void Simulation::sample_body_fields() {
       }
     const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
     const Shape& shape = scene_.bodies[b].shape;
-    const Vec2 across = across_motion(scene_.bodies[b].motion);
+    // across the body's travel (a path that turns keeps the direction of its middle)
+    const Vec2 travel = travel_direction(scene_, scene_.bodies[b]), across(-travel.y(), travel.x());
     // distance from q to the surface along +-across (bisection on the SDF; the body is inside its box)
     auto depth_across = [&](const Vec2& q) {
       const double far = (s.hi_m - s.lo_m).norm();
