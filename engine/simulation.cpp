@@ -347,6 +347,7 @@ void Simulation::sample_body_fields() {
     body_samples_m_.push_back(std::move(samples));
   }
   body_sample_mass_kg_ = density * h * h;
+  body_node_full_kg_ = density * dx * dx;  // the field at a node whose whole stencil it fills
 }
 
 void Simulation::step() {
@@ -673,8 +674,9 @@ void Simulation::bodies_and_walls() {
 // Cell-fraction contact (Fraction): the body is also a mass field on the grid, scattered from
 // sample points fixed in its frame (contact_cell_fraction), and a node takes the share
 // m_body / (m_body + m_media) of the correction, as multi-field contact of the media against a
-// body of finite mass would (Bardenhagen et al. 2001). The share is a smooth function of the
-// body's position, so no node switches on at once as a face crosses a node line. The correction
+// body of finite mass would (Bardenhagen et al. 2001), scaled up to reach 1 where the field
+// covers the node fully, since a driven body has no finite mass. The share is a smooth function
+// of the body's position, so no node switches on at once as a face crosses a node line. The correction
 // itself is the mass-weighted mean of what each media point in the node's stencil asks of it: the
 // node's velocity held against the body along that point's own face normal (Coulomb slip along
 // it). One normal per node flips where the node crosses a thin body's medial axis (a node row of
@@ -704,7 +706,10 @@ void Simulation::contact_nodes() {
             continue;
           }
           if (!touched_[b][k]) continue;
-          share = m_body / (m_body + n.m);
+          // the multi-field share m_body / (m_body + m), scaled to reach 1 where the body's field
+          // covers the node fully (m_body = body_node_full_kg_): a driven body has no finite mass,
+          // and a share below 1 inside it let the material under it lag it (README, "Body contact")
+          share = std::min(1.0, m_body * (body_node_full_kg_ + n.m) / ((m_body + n.m) * body_node_full_kg_));
         } else if (n.m <= 0.0 || shape_sdf(body.shape, q) >= 0.0) {
           continue;
         }

@@ -264,6 +264,7 @@ class Simulation {
   std::vector<std::vector<uint8_t>> touched_;
   std::vector<std::vector<Vec2>> body_samples_m_;
   double body_sample_mass_kg_ = 0.0;
+  double body_node_full_kg_ = 0.0;
   std::vector<std::vector<double>> body_node_mass_kg_;
   // cell-fraction contact, per body over its node box: the points' summed velocity changes (kg m/s)
   // and the mass they came with (kg), both weighted by the points' weights

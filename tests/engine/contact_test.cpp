@@ -92,18 +92,18 @@ TEST(ContactSmoothness, LooseIntrusionHasNoSpikes) {
 }
 
 // Cell-fraction contact on the same two templates. plate_intrusion (its plate's sides lie on node
-// lines): 1.151x, RMS 1.46%, cell component 0.73% (node 1.46x, 8.9%, 7.8%); the same plate half a
-// cell off the node lines: 1.139x, 1.24%, 0.60%. The issue asks 1.15x: the one step above it is
-// two points riding the plate's leading face near its corners, kicked 0.2 m/s into it by FLIP and
-// put back by G2P's safety net (README, "Body contact"), so the peak bound here is 1.16. The
-// mass-gradient normal this method used before met the peak (1.13x) but not the rest half a
-// cell sideways (2.15%, 2.0%); its first form, a ramp, met the first case (1.12x, 2.4%, 2.05%) but
-// not the second (1.09x, 5.3%, 5.9%), which is why the test runs both. loose_intrusion: 1.17x
-// from three cells of penetration (node 4.8x).
+// lines): 1.133x, RMS 1.61%, cell component 0.86% (node 1.46x, 8.9%, 7.8%); the same plate half a
+// cell off the node lines: 1.086x, 1.11%, 0.84%. Before the share reached 1 inside the body
+// (2026-12-02) the first was 1.151x: points riding the plate's leading face near its corners,
+// kicked into it by FLIP and put back by G2P's safety net (README, "Body contact"). The
+// mass-gradient normal this method used before met the peak (1.13x) but not the rest half a cell
+// sideways (2.15%, 2.0%); its first form, a ramp, met the first case (1.12x, 2.4%, 2.05%) but not
+// the second (1.09x, 5.3%, 5.9%), which is why the test runs both. loose_intrusion: 1.14x from
+// three cells of penetration (node 4.8x).
 TEST(ContactSmoothness, CellFractionPlateIntrusionHasNoCellComb) {
   for (double shift_cells : {0.0, 0.5}) {
     const ForceSmoothness f = plate_intrusion_smoothness(ContactMethod::CellFraction, shift_cells);
-    EXPECT_LE(f.peak_ratio, 1.16) << "shifted " << shift_cells << " cell";
+    EXPECT_LE(f.peak_ratio, 1.15) << "shifted " << shift_cells << " cell";
     EXPECT_LE(f.cell_amplitude_relative, 0.02) << "shifted " << shift_cells << " cell";
     EXPECT_LE(f.rms_relative, 0.02) << "shifted " << shift_cells << " cell";
   }
