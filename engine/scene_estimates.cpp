@@ -193,8 +193,8 @@ double body_cells_across(const Scene& scene, const Body& body) {
 
 double contact_size_bias(ContactMethod method, double cells_across) {
   // plate L 0.04 m against ~297 N/m (64 cells): node -16 / -7 / -3%, particle +33 / +22 / +8% at
-  // 8 / 16 / 32 cells; cell_fraction (points' own normals, 2026-12-02) 291 / 293 / 307 N/m in a bed
-  // where node gave 248 / 263 / 279: a few % low at 8 cells
+  // 8 / 16 / 32 cells; cell_fraction (its share reaching 1 inside the body, 2026-12-02) 292 / 295 /
+  // 308 N/m in a bed where node gave 248 / 263 / 279: a few % low at 8 cells
   const double c = method == ContactMethod::Node ? -1.1 : method == ContactMethod::CellFraction ? -0.4 : 2.8;
   return cells_across > 0.0 ? c / cells_across : 0.0;
 }
