@@ -205,11 +205,12 @@ TEST(PaperCase2, SinglePlateOnsetForceScalesAsL2AndDeepForceAsL) {
   for (size_t i = 0; i < n; ++i) {
     const double L = widths_m[i];
     const DepthTrace d = depth_trace(traces[i], 0.5 * onset_dx);
+    const double onset_from = 0.125 * L, onset_to = 0.5 * L;  // the same relative depths for every width
     std::vector<double> zs, Fs;
     for (size_t k = 0; k < d.z_m.size(); ++k)
-      if (d.z_m[k] >= 0.125 * L && d.z_m[k] <= 0.5 * L) zs.push_back(d.z_m[k]), Fs.push_back(d.F_N_per_m[k]);
+      if (d.z_m[k] >= onset_from && d.z_m[k] <= onset_to) zs.push_back(d.z_m[k]), Fs.push_back(d.F_N_per_m[k]);
     const Fit line = fit_line(zs, Fs);
-    onset.push_back(depth_mean(d, 0.125 * L, 0.5 * L));
+    onset.push_back(depth_mean(d, onset_from, onset_to));
     deep.push_back(depth_mean(depth_trace(traces[n + i], 0.5 * dx), z_from, z_to));
     std::printf("case 2 single: L %.3f m  onset %.1f N/m (F/(rho_d g L^2 w) %.2f; line: z -> 0 %.1f N/m, N_gamma %.2f, "
                 "slope %.0f N/m^2, N_q %.2f)  deep mean %.1f N/m (F/(rho_d g z L w) %.2f)  (%zu + %zu particles, "
