@@ -161,11 +161,11 @@ TEST_F(SceneCli, ValidateGivesCellsAcrossTheTravelAndTheContactBias) {
   Result r = run({"validate", file, "--brief"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("plate: box, 10 cells across its travel"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("node contact (a plate this many cells across reads ~11% low"), std::string::npos) << r.err;
-  r = run({"validate", file, "--brief", "--set", "domain.dx_m=0.005", "--set", "solver.contact=cell_fraction"});
+  EXPECT_NE(r.err.find("cell_fraction contact (a plate this many cells across reads ~4% low"), std::string::npos) << r.err;
+  r = run({"validate", file, "--brief", "--set", "domain.dx_m=0.005", "--set", "solver.contact=node"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("20 cells across its travel"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("cell_fraction contact (a plate this many cells across reads ~2% low"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("node contact (a plate this many cells across reads ~6% low"), std::string::npos) << r.err;
   r = run({"validate", file, "--brief", "--set", "bodies.plate.motion.velocity_m_s=[0.1,0.0]"});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("2 cells across its travel"), std::string::npos) << r.err;

@@ -102,6 +102,7 @@ Scene plowing_scene(double phi_i, double dx, double travel_m, double bed_w, doub
   const double plate_h = 0.08, depth = 0.05;
   Scene s = bed_scene(dpm_material("glass_beads", 2520.0, 0.40, 5.0, 5.0e6), bed_w, bed_h, air_m, dx, 100.0, phi_i);
   s.name = "plowing_test";
+  s.solver.contact = ContactMethod::CellFraction;  // as the plowing template (node until 2026-12-02)
   s.solver.end_displacement_m = travel_m;
   s.solver.threads = 1;  // the two beds run side by side, one core each
   s.effects.dilatancy = true;

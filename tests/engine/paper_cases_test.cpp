@@ -128,10 +128,12 @@ TEST(PaperCase1, CylinderLiftLevelsOffInPaperBed) {
 constexpr double kPlateV = 0.2, kPlateE = 1.25e6;
 
 // A bed of `width` x `depth` with plates of width L (thickness 2 dx) whose bottoms start half a cell
-// above the surface at the given centres, all moving down together.
+// above the surface at the given centres, all moving down together. Cell-fraction contact, as the
+// plate_intrusion and two_plates templates use (node contact until 2026-12-02; README table).
 Scene plates_scene(double width_m, double depth_m, double dx_m, double L_m, const std::vector<double>& centres_m,
                    double travel_m, double E_Pa = kPlateE) {
   Scene s = bed(width_m, depth_m, 4.0 * dx_m, dx_m, 0.40);
+  s.solver.contact = ContactMethod::CellFraction;
   s.materials[0].youngs_modulus_Pa = E_Pa;
   const double gap = 0.5 * dx_m, t = 2.0 * dx_m;
   s.solver.end_displacement_m = gap + travel_m;
@@ -232,8 +234,9 @@ TEST(PaperCase2, SinglePlateOnsetForceScalesAsL2AndDeepForceAsL) {
 // plate-bottom depths z in [0.07, 0.09] m, 2..3.6 plate widths deep (the F ~ z L regime the paper's
 // scaling assumes; its own window, 0.4..0.8 L, is where a 2 L plate still carries a large L^2 share).
 // s = 0 is one plate of width 2 L, s -> infinity one plate of width L (per plate: its own force).
-// dx 2.5 mm: 10 and 15 cells per plate; gaps of 3 cells and more (s/L >= 0.3 at 10 cells): grid
-// contact reaches ~1.5 cells beyond each plate, so a narrower gap is numerically closed.
+// dx 2.5 mm: 10 and 15 cells per plate; gaps of 3 cells and more (s/L >= 0.3 at 10 cells): node
+// contact reaches ~1.5 cells beyond each plate, so a narrower gap was numerically closed (kept
+// with cell_fraction, which holds material only once it touches).
 // Each bed: the plate system's span, 1.5 spans of bed on each side and one span under the window
 // (a floor 0.7 spans under the plates raised the force of a 2 L plate).
 constexpr double kPairDx = 0.0025;
