@@ -211,9 +211,12 @@ int study_main(const Parsed& p) {
     return rungs[a].estimated_particle_steps < rungs[b].estimated_particle_steps;
   });
   if (!quiet) {
-    std::fprintf(stderr, "furrow study: %zu rungs of %s (%zu already done), %d at a time, %d thread%s each -> %s\n",
-                 rungs.size(), base.name.c_str(), reused, jobs, threads_each, threads_each == 1 ? "" : "s",
-                 out_dir.string().c_str());
+    // the threads the rungs run on: --threads / solver.threads where set, else cores / jobs
+    const int threads = scenes.front().solver.threads;
+    const bool same = std::all_of(scenes.begin(), scenes.end(), [&](const Scene& x) { return x.solver.threads == threads; });
+    const std::string each = same ? std::to_string(threads) + (threads == 1 ? " thread" : " threads") : "the rungs' own threads";
+    std::fprintf(stderr, "furrow study: %zu rungs of %s (%zu already done), %d at a time, %s each -> %s\n",
+                 rungs.size(), base.name.c_str(), reused, jobs, each.c_str(), out_dir.string().c_str());
   }
   write_outputs(false);
 
