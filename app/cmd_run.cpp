@@ -36,8 +36,8 @@ Scene load_varied_scene(const Parsed& p, const std::string& path, const std::vec
     return load_scene_for_cli(q, path);
   } catch (const SceneError& e) {
     for (size_t k = 0; k < varies.size(); ++k)
-      for (const auto& key : varies[k].keys) {
-        const std::string a = key + "=" + varies[k].values[combo[k]];
+      for (size_t i = 0; i < varies[k].keys.size(); ++i) {
+        const std::string a = varies[k].keys[i] + "=" + varies[k].per_key[combo[k]][i];
         if (e.note == "set by --set " + a || e.note == "in --set " + a)
           throw SceneError(e.file, e.path, e.value, e.expected, "set by " + option + " " + varies[k].spec + " as " + a,
                            e.line, e.column, e.byte);

@@ -108,8 +108,23 @@ Vary parse_vary(const std::string& spec) {
     }
   }
   std::set<std::string> seen;
-  for (const auto& val : v.values)
+  for (const auto& val : v.values) {
     if (!seen.insert(val).second) throw VaryError(where + "value " + val + " is listed twice");
+    std::vector<std::string> parts = split_top_level(val, ';');
+    if (parts.size() == 1) {
+      v.per_key.emplace_back(v.keys.size(), val);
+      continue;
+    }
+    if (parts.size() != v.keys.size())
+      throw VaryError(where + "value '" + val + "' gives " + std::to_string(parts.size()) +
+                      " values separated by ';' for " + std::to_string(v.keys.size()) +
+                      " key(s) (expected one per key joined by '+', or one value for all)");
+    for (auto& part : parts) {
+      part = trim(part);
+      if (part.empty()) throw VaryError(where + "empty value in '" + val + "' (values are separated by ';')");
+    }
+    v.per_key.push_back(parts);
+  }
   return v;
 }
 
@@ -134,7 +149,8 @@ std::vector<std::vector<size_t>> combinations(const std::vector<Vary>& varies) {
 std::vector<std::string> run_overrides(const std::vector<Vary>& varies, const std::vector<size_t>& combo) {
   std::vector<std::string> sets;
   for (size_t k = 0; k < varies.size(); ++k)
-    for (const auto& key : varies[k].keys) sets.push_back(key + "=" + varies[k].values[combo[k]]);
+    for (size_t i = 0; i < varies[k].keys.size(); ++i)
+      sets.push_back(varies[k].keys[i] + "=" + varies[k].per_key[combo[k]][i]);
   return sets;
 }
 

@@ -23,12 +23,15 @@ struct VaryError : std::runtime_error {
 //          several joined by '+', which all take the same value (e.g. the widths of two plates)
 //   VALUES a:b:step (numbers; b included when the steps land on it within 1e-9 of a step) or a
 //          comma-separated list v1,v2,... of JSON values or plain strings (commas inside [] {} or
-//          quotes do not split)
+//          quotes do not split); with several KEYS a list value may give one value per key,
+//          separated by ';' (two plates' start points at each separation of a pair)
 struct Vary {
   std::string spec;                 // as given
   std::string column;               // KEYS as given: the sweep.csv column name
   std::vector<std::string> keys;    // KEYS split at '+'
   std::vector<std::string> values;  // value texts, in sweep order
+  // per_key[v][k]: what key k is set to for values[v]
+  std::vector<std::vector<std::string>> per_key;
 };
 
 Vary parse_vary(const std::string& spec);

@@ -166,6 +166,8 @@ TEST_F(SweepCli, MalformedVaryIsAUsageError) {
       {"bodies.plate.friction=0.1,,0.2", "empty value"},
       {"bodies.plate.friction=0.1,0.1", "listed twice"},
       {"bodies.plate.friction+=0.1", "empty key path"},
+      {"bodies.plate.friction+bodies.rod.friction=0.1;0.2;0.3", "3 values separated by ';' for 2 key(s)"},
+      {"bodies.plate.friction+bodies.rod.friction=0.1;", "empty value in '0.1;'"},
   };
   for (const auto& c : cases) {
     const Result r = run({"sweep", path("tiny.json"), "--vary", c.vary, "--out", path("sw")});
@@ -201,6 +203,26 @@ TEST_F(SweepCli, LinkedKeysTakeTheSameValueAndRangesIncludeTheirEnd) {
     const auto scene = nlohmann::json::parse(read_text(path("sw/" + csv.rows[i].at("run") + "/scene.json")));
     EXPECT_DOUBLE_EQ(scene["bodies"][0]["friction"].get<double>(), std::stod(values[i]));
     EXPECT_DOUBLE_EQ(scene["bodies"][1]["friction"].get<double>(), std::stod(values[i]));
+  }
+}
+
+// A pair's separation moves both plates, each its own way: one value per key, separated by ';',
+// in step (not a cartesian product); the table's column keeps the value as given.
+TEST_F(SweepCli, LinkedKeysTakeOneValueEachWhenSeparatedBySemicolons) {
+  const Result r = run({"sweep", path("tiny.json"), "--vary",
+                        "bodies.plate.friction+bodies.rod.friction=0.1;0.3,0.2;0.4,0.5",
+                        "--set", "solver.end_displacement_m=0.01", "--set", "outputs.average_window.to_m=0.01",
+                        "--out", path("sw")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Csv csv = read_csv(path("sw/sweep.csv"));
+  ASSERT_EQ(csv.rows.size(), 3u);
+  const std::vector<std::string> given = {"0.1;0.3", "0.2;0.4", "0.5"};
+  const std::vector<double> plate = {0.1, 0.2, 0.5}, rod = {0.3, 0.4, 0.5};
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(csv.rows[i].at("bodies.plate.friction+bodies.rod.friction"), given[i]);
+    const auto scene = nlohmann::json::parse(read_text(path("sw/" + csv.rows[i].at("run") + "/scene.json")));
+    EXPECT_DOUBLE_EQ(scene["bodies"][0]["friction"].get<double>(), plate[i]);
+    EXPECT_DOUBLE_EQ(scene["bodies"][1]["friction"].get<double>(), rod[i]);
   }
 }
 
