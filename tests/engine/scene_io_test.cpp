@@ -106,13 +106,13 @@ TEST(SceneTemplates, PaperGeometry) {
     EXPECT_EQ(s.solver.end_displacement_m, 0.14);
     EXPECT_EQ(furrow::estimate_particle_count(s), 28800u);  // 1.2 * 0.6 / 0.01^2 * 2^2
   }
-  {  // case 2 pair: 0.04 m between inner edges (4 preview cells), symmetric about x = 0.6
+  {  // case 2 pair: 0.02 m between inner edges (s/L 0.2, the preview's peak), symmetric about x = 0.6
     const Scene s = load_template("two_plates");
     ASSERT_EQ(s.bodies.size(), 2u);
     const auto &a = s.bodies[0], &b = s.bodies[1];
     const double gap_m = (b.start_m.x() - 0.5 * b.shape.size_m.x()) - (a.start_m.x() + 0.5 * a.shape.size_m.x());
-    EXPECT_NEAR(gap_m, 0.04, tol);
-    EXPECT_GE(gap_m / s.domain.dx_m, 4.0 - 1e-9);
+    EXPECT_NEAR(gap_m, 0.02, tol);
+    EXPECT_NEAR(gap_m / a.shape.size_m.x(), 0.2, tol);
     EXPECT_NEAR(0.5 * (a.start_m.x() + b.start_m.x()), 0.6, tol);
     EXPECT_EQ(a.start_m.y(), b.start_m.y());
   }
