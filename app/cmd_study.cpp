@@ -364,7 +364,7 @@ Command command_study() {
             "The reference is the Richardson value of the settings that hold the most expensive rung, or\n"
             "that rung's value. Ctrl-C or a failed rung keeps the finished rungs and their table; running the\n"
             "same command again reuses every rung whose directory holds a complete run of the same scene\n"
-            "(threads aside) and runs the rest. A directory holding a different run is an error (nothing\n"
+            "(threads, movies aside) and runs the rest. A directory holding a different run is an error (nothing\n"
             "runs). Threads per rung: cores / N unless the scene or --threads sets them; for timings that\n"
             "compare, keep --jobs 1. Rungs write no movies and no ParaView files; each rung's scene is in\n"
             "DIR/scenes and its output in DIR/logs.",

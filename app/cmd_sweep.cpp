@@ -327,7 +327,8 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
   write_file_atomic((d.work_dir / "sweep.json").string(), j.dump(2) + "\n");
   bool plotted = false;
   try {
-    render::write_figure_png(figure.figure, (d.work_dir / "sweep.png").string(), false);
+    // the directory holds this sweep (decide() checked): its figure follows the table just written
+    render::write_figure_png(figure.figure, (d.work_dir / "sweep.png").string(), true);
     plotted = true;
   } catch (const std::exception& e) {
     std::cerr << "furrow sweep: warning: no sweep.png: " << e.what() << "\n";
@@ -407,14 +408,14 @@ Command command_sweep() {
             "VALUES is a:b:step (b included) or a list v1,v2,... (JSON values, e.g. [0.05,0.02]); KEYS is a\n"
             "--set key path, or several joined by '+' that take the same value, or one each when a list\n"
             "value gives one per key separated by ';' (a pair's separation:\n"
-            "--vary 'bodies.0.start_m+bodies.1.start_m=[0.55,0.615];[0.65,0.615],[0.54,0.615];[0.66,0.615]').\n"
+            "--vary 'bodies.0.start_m.0+bodies.1.start_m.0=0.55;0.65,0.54;0.66,0.35;0.85').\n"
             "Threads per run are cores / N unless the scene or --threads sets them.\n"
             "Under mpirun or srun the runs spread over the ranks, longest predicted (particle-steps)\n"
             "first, each rank taking the next when it finishes, on its node's cores / ranks there; rank 0\n"
             "writes the table. A combination whose scene is invalid, or a run that fails, is a row with\n"
             "status failed and its error; the others run, and the sweep exits 1 saying how many failed.\n"
             "Running the same sweep again into DIR (stopped, killed or with failures) reuses every run\n"
-            "whose directory holds a finished run of the same scene (threads aside) and runs the rest; a\n"
+            "whose directory holds a finished run of the same scene (threads, movies aside) and runs the rest; a\n"
             "run of a different scene there is an error naming it and the keys that differ. A DIR\n"
             "holding another sweep is replaced only with --force, once the new sweep is complete.",
             {{"--vary", true, true, "a key path and its values: key.path=a:b:step or key.path=v1,v2", "KEYS=VALUES"},

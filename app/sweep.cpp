@@ -340,6 +340,9 @@ RunMetrics run_metrics(const Scene& scene, const RunSummary& summary,
     const Body *a = &scene.bodies[boxes[0]], *c = &scene.bodies[boxes[1]];
     if (a->start_m.x() > c->start_m.x()) std::swap(a, c);
     m.gap_m = (c->start_m.x() - 0.5 * c->shape.size_m.x()) - (a->start_m.x() + 0.5 * a->shape.size_m.x());
+    // to the nanometre: touching plates read s = 0, not the -1e-16 of decimal positions in binary
+    m.gap_m = std::round(m.gap_m * 1e9) * 1e-9;
+    if (m.gap_m == 0.0) m.gap_m = 0.0;  // not -0
   }
   m.total_F0_N_per_m = m.rho_d_kg_m3 * m.g_m_s2 * m.z_m * m.L_avg_m * 1.0;
   m.total_mean_drag_N_per_m = boxes.empty() ? kNaN : 0.0;

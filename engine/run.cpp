@@ -34,6 +34,7 @@ size_t peak_resident_bytes() {
 nlohmann::json result_defining_json(const Scene& scene) {
   Scene s = scene;
   s.solver.threads = 0;
+  s.outputs.movies.clear();  // drawn from the stored frames after the run; a sweep skips them
   return scene_to_json(s);
 }
 

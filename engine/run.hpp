@@ -67,7 +67,8 @@ struct RunSummary {
 RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
 // The resolved scene without what cannot change a run's results (solver.threads: runs are
-// bit-identical for any thread count): two runs are of the same scene when these are equal.
+// bit-identical for any thread count; outputs.movies: rendered from the frames afterwards): two
+// runs are of the same scene when these are equal.
 nlohmann::json result_defining_json(const Scene& scene);
 // FNV-1a 64 of result_defining_json(scene).dump() as 16 hex digits; run.json's "scene_hash", so a
 // finished run directory says which scene it completed without reparsing its scene.json.

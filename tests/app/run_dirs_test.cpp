@@ -37,10 +37,18 @@ class RunDirs : public ::testing::Test {
 
 }  // namespace
 
-TEST(SceneHash, IgnoresThreadsOnlyAndIsStable) {
+TEST(SceneHash, IgnoresThreadsAndMoviesOnlyAndIsStable) {
   const Scene a = tiny(), b = tiny({"solver.threads=7"}), c = tiny({"domain.dx_m=0.004"});
   EXPECT_EQ(scene_hash(a), scene_hash(b));
   EXPECT_NE(scene_hash(a), scene_hash(c));
+  // movies are drawn from the frames; the frames' fields are results
+  const std::vector<std::string> frames = {"outputs.frame_interval_s=0.05", R"(outputs.fields=["pressure"])"};
+  std::vector<std::string> with_movie = frames;
+  with_movie.push_back(R"(outputs.movies=["pressure"])");
+  std::vector<std::string> more_fields = frames;
+  more_fields.back() = R"(outputs.fields=["pressure","strain_rate"])";
+  EXPECT_EQ(scene_hash(tiny(frames)), scene_hash(tiny(with_movie)));
+  EXPECT_NE(scene_hash(tiny(frames)), scene_hash(tiny(more_fields)));
   EXPECT_EQ(scene_hash(a).size(), 16u);
   EXPECT_EQ(scene_hash(a).find_first_not_of("0123456789abcdef"), std::string::npos);
   // the written scene, read back, is the same scene

@@ -179,6 +179,23 @@ TEST_F(SweepResume, StoppedSweepRunsOnlyTheMissingRunsAgain) {
   expect_rerun_completes_only_the_rest(before, run(sweep(vary, "sw")), path("sw"), 4);
 }
 
+// The templates name movies; a sweep renders them only with --movies. What defines a run's
+// result leaves the movies out (they are drawn from the stored frames afterwards), so the same
+// sweep again reuses its finished runs (until 2026-12-03 every template's runs were "a different
+// scene, differs at /outputs/movies" and the rerun stopped).
+TEST_F(SweepResume, SceneWithMoviesIsReusedBySweepsThatDoNotRenderThem) {
+  const std::vector<std::string> vary = {"--vary", "bodies.rod.start_m.1=0.03,0.035", "--set",
+                                         R"(outputs.movies=["pressure"])", "--set", R"(outputs.fields=["pressure"])",
+                                         "--set", "outputs.frame_interval_s=0.05"};
+  const Result first = run(sweep(vary, "sw"));
+  ASSERT_EQ(first.status, 0) << first.err;
+  const auto before = finished_runs(path("sw"));
+  ASSERT_EQ(before.size(), 2u);
+  const Result again = run(sweep(vary, "sw"));
+  expect_rerun_completes_only_the_rest(before, again, path("sw"), 2);
+  EXPECT_EQ(again.err.find("no sweep.png"), std::string::npos) << "the figure follows the table: " << again.err;
+}
+
 TEST_F(SweepResume, StoppedMpiJobRunsOnlyTheMissingRunsAgain) {
   if (const std::string why = mpi_unavailable(); !why.empty()) GTEST_SKIP() << why;
   // runs long enough (dx 2.5 mm) that the second pair cannot finish while the stop reaches the ranks
