@@ -241,8 +241,8 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 // Frames: one per third of a cell of travel, taken when the face is 0.45, 0.65 and 0.85 cell
 // above the grid node line below it. With `node` contact the body constrains only grid nodes inside
 // it, so as the face descends through a cell the layer under it is pushed less and less and the zone
-// could vanish from a frame; `cell_fraction` (the template's since 2026-12-03) holds that layer at
-// every offset, and the offsets are kept so both methods are sampled alike. Single frames scatter
+// could vanish from a frame; `cell_fraction` (the template's since 2026-12-03) takes a share that
+// moves smoothly with the face instead, and the offsets are kept so both methods are sampled alike. Single frames scatter
 // by ~8 deg (particle noise on 16 cells), so the claim is tested on medians: early = the first
 // 12.5 mm of intrusion (0.3 L), late = 30-50 mm.
 //
