@@ -297,8 +297,9 @@ TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
   EXPECT_GE(early_apex, late_apex + 5.0) << "early " << early_apex << ", late " << late_apex;
   // it grows: early no taller than the slip-line wedge at the initial friction, scaled to the late one
   const double early_height = median_finite(early_h), late_height = median_finite(late_h);
+  const MaterialParams bed = MaterialParams::from(s.materials[0], true);
   const auto half_tan = [](double mu) { return std::tan(0.5 * slip_line_apex_angle_deg(mu) * M_PI / 180.0); };
-  const double full_wedge_ratio = half_tan(0.53) / half_tan(0.53 + (0.55 - 0.60) * 5.0);  // 0.79
+  const double full_wedge_ratio = half_tan(bed.mu) / half_tan(bed.friction(s.beds[0].packing_fraction));  // 0.79
   RecordProperty("early_over_late_height", std::to_string(early_height / late_height));
   EXPECT_LT(early_height, full_wedge_ratio * late_height) << "early " << early_height << ", late " << late_height;
 }
