@@ -231,9 +231,12 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 // truncation) and sharpens, as its flanks compact and strengthen, toward pi/2 - atan(mu_c) =
 // 62 deg (engine/analysis.hpp: why the full apex angle).
 //
-// Resolution: dx 2.5 mm puts 16 cells across the plate (paper: 80). Measured with `node` at tolerance 0.1,
+// Resolution: dx 2 mm puts 20 cells across the plate (paper: 80). Measured with `node` at tolerance 0.1,
 // late medians: 61-64 deg at dx 2.5 and 2 mm; 67 deg at dx 3.3 mm, where the flanks' shear
-// bands (2-3 cells) are a fifth of the plate wide. Bed 0.25 x 0.16 m (paper 0.5 x 0.2): the
+// bands (2-3 cells) are a fifth of the plate wide. `cell_fraction` spreads the plate's edge over
+// a cell's share, so it needs the finer of the two: at dx 2.5 mm 67.9 deg, and 70.8 after a
+// round-off change (the pressure's log series, 2026-12-03), too near the 8 deg bound to test the
+// claim; at dx 2 mm 64.8 and 65.1 deg. Bed 0.25 x 0.16 m (paper 0.5 x 0.2): the
 // Prandtl mechanism of a 40 mm plate reaches about 2.5 plate widths across and the final zone's
 // apex sits 85 mm above the floor; a 0.3 x 0.2 m bed gives a late median within 3 deg of this
 // one (measured 60.9 vs 63.7).
@@ -243,7 +246,7 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 // it, so as the face descends through a cell the layer under it is pushed less and less and the zone
 // could vanish from a frame; `cell_fraction` (the template's since 2026-12-03) takes a share that
 // moves smoothly with the face instead, and the offsets are kept so both methods are sampled alike. Single frames scatter
-// by ~8 deg (particle noise on 16 cells), so the claim is tested on medians: early = the first
+// by ~8 deg (particle noise on 16-20 cells), so the claim is tested on medians: early = the first
 // 12.5 mm of intrusion (0.3 L), late = 30-50 mm.
 //
 // Growth: a complete slip-line wedge under a plate of width L is (L/2) / tan(apex/2) tall, 26.3 mm
@@ -251,9 +254,9 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 // at most that short wedge, so it is at most tan(31.0 deg) / tan(37.2 deg) = 0.79 of the late one
 // (both shortened alike by the 10% speed criterion); a zone that did not grow gives 1. Until
 // 2026-12-03 the bound was 0.6, set from `node`'s 0.54 with no physics behind it; `cell_fraction`
-// measured 0.606 (README, Body contact).
+// measured 0.606 and 0.661 at dx 2.5 mm, 0.550 and 0.546 at 2 mm (README, Body contact).
 TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
-  const double dx = 0.0025, bed_w = 0.25, bed_h = 0.16, gap = 0.002, v = 0.15, travel = 0.05;
+  const double dx = 0.002, bed_w = 0.25, bed_h = 0.16, gap = 0.002, v = 0.15, travel = 0.05;
   Scene s = bed_scene(dpm_material("poppy_seeds", 1100.0, 0.53, 5.0, 2.0e6), bed_w, bed_h, 0.03, dx, 10.0, 0.55);
   s.name = "loose_intrusion_test";
   s.solver.contact = ContactMethod::CellFraction;  // as the loose_intrusion template (node until 2026-12-03)
@@ -290,9 +293,9 @@ TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
   RecordProperty("early_apex_deg", std::to_string(early_apex));
   RecordProperty("late_apex_deg", std::to_string(late_apex));
   ASSERT_GE(early_deg.size(), 6u);
-  ASSERT_EQ(late_frames, 24);  // 20 mm = 8 cells, 3 frames each
+  ASSERT_EQ(late_frames, 30);  // 20 mm = 10 cells, 3 frames each
   // the zone exists and has flanks in nearly every late frame
-  EXPECT_GE(std::count_if(late_deg.begin(), late_deg.end(), [](double a) { return std::isfinite(a); }), 21);
+  EXPECT_GE(std::count_if(late_deg.begin(), late_deg.end(), [](double a) { return std::isfinite(a); }), 27);
   EXPECT_NEAR(late_apex, slip_line, 8.0) << "early " << early_apex << ", late " << late_apex;
   EXPECT_GE(early_apex, late_apex + 5.0) << "early " << early_apex << ", late " << late_apex;
   // it grows: early no taller than the slip-line wedge at the initial friction, scaled to the late one
