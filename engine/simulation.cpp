@@ -71,13 +71,6 @@ inline Vec4d splat(double v) { return Vec4d{v, v, v, v}; }
 #if defined(__AVX__)
 inline Vec4d lane(const Vec4d& v, int l) { return (Vec4d)_mm256_broadcast_sd(&v[l]); }  // v[l] in every lane
 #endif
-inline double fma1(double a, double b, double c) {
-#if defined(__FMA__)
-  return std::fma(a, b, c);
-#else
-  return a * b + c;
-#endif
-}
 
 #if defined(__AVX__)
 typedef float Vec4f __attribute__((vector_size(16)));
@@ -1323,12 +1316,19 @@ size_t Simulation::constitutive_by_four(size_t begin, size_t end) {
       const V f = mp.mu + (pd - mp.phi_c) * mp.chi;
       return pick(zero < f, f, zero);
     };
-    // P = K log_near_one(phi / phi_d): its series where |q - 1| <= 1e-3, else the library's log
-    // (the lanes in `needed`; the others take the series, whatever it gives there)
+    // P = K log_near_one(phi / phi_d): log_series's operations lane by lane where |q - 1| is in
+    // its reach, else the library's log (the lanes in `needed`; the others keep whatever the
+    // series gives there)
     auto pressure_of = [&](const V& pd, const M& needed) {
       const V q = phi / pd, x = q - 1.0;
-      const M series = (x <= 1e-3) & (x >= -1e-3);
-      V pressure = mp.K * (x * (1.0 - x * (0.5 - x * (1.0 / 3.0 - x * (0.25 - x * (0.2 - x * (1.0 / 6.0)))))));
+      const M series = (x <= kLogSeriesReach) & (x >= -kLogSeriesReach);
+      const V y = x / (2.0 + x), y2 = y * y;
+      V s = fma4(y2, splat(1.0 / 13.0), splat(1.0 / 11.0));
+      s = fma4(s, y2, splat(1.0 / 9.0));
+      s = fma4(s, y2, splat(1.0 / 7.0));
+      s = fma4(s, y2, splat(1.0 / 5.0));
+      s = fma4(s, y2, splat(1.0 / 3.0));
+      V pressure = mp.K * fma4(2.0 * y, y2 * s, 2.0 * y);
       for (int l = 0; l < 4; ++l)
         if (!series[l] && needed[l]) pressure[l] = mp.K * std::log(q[l]);
       return pressure;

@@ -272,10 +272,11 @@ TEST(RateDependence, DpmAddsTheRatePartToTheStateFriction) {
 }
 
 // The pressure's log of phi / phi_d: the series used near 1 agrees with the library log to round-off
-// (a few units in the last place) on both sides of 1 and at the switch to std::log.
+// (a few units in the last place) on both sides of 1, through all its reach and past the switch to
+// std::log.
 TEST(LogNearOne, MatchesTheLibraryLogToRoundOff) {
   double worst = 0.0;
-  for (double x = 1e-14; x < 2e-3; x *= 1.01)
+  for (double x = 1e-14; x < 2.0 * kLogSeriesReach; x *= 1.001)
     for (double q : {1.0 + x, 1.0 - x}) {
       const double ref = std::log(q), got = log_near_one(q);
       worst = std::max(worst, std::abs(got - ref) / std::abs(ref));
