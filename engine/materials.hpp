@@ -90,19 +90,21 @@ inline double fma1(double a, double b, double c) {
 // and the result to about an ulp (tested). Cheaper than the library log (the update's instructions
 // -35% on plate_intrusion, README), and the same operations in every lane of the four-wide update
 // (simulation.cpp), which must give the same bits.
+// T is double, or a GCC vector of doubles (one lane per point) with its own `fma`.
 constexpr double kLogSeriesReach = 0.1;
-inline double log_series(double x) {
-  const double y = x / (2.0 + x), y2 = y * y;
-  double s = fma1(y2, 1.0 / 13.0, 1.0 / 11.0);
-  s = fma1(s, y2, 1.0 / 9.0);
-  s = fma1(s, y2, 1.0 / 7.0);
-  s = fma1(s, y2, 1.0 / 5.0);
-  s = fma1(s, y2, 1.0 / 3.0);
-  return fma1(2.0 * y, y2 * s, 2.0 * y);
+template <class T, class Fma> inline T log_series(const T& x, Fma fma) {
+  const T zero{};  // zero + c: c itself, or c in every lane
+  const T y = x / (2.0 + x), y2 = y * y;
+  T s = fma(y2, zero + 1.0 / 13.0, zero + 1.0 / 11.0);
+  s = fma(s, y2, zero + 1.0 / 9.0);
+  s = fma(s, y2, zero + 1.0 / 7.0);
+  s = fma(s, y2, zero + 1.0 / 5.0);
+  s = fma(s, y2, zero + 1.0 / 3.0);
+  return fma(2.0 * y, y2 * s, 2.0 * y);
 }
 inline double log_near_one(double q) {
   const double x = q - 1.0;
-  return std::abs(x) <= kLogSeriesReach ? log_series(x) : std::log(q);
+  return std::abs(x) <= kLogSeriesReach ? log_series(x, fma1) : std::log(q);
 }
 
 // Shared by both models; Dilatancy selects the DPM state law and Rate the mu(I) friction at

@@ -1316,19 +1316,12 @@ size_t Simulation::constitutive_by_four(size_t begin, size_t end) {
       const V f = mp.mu + (pd - mp.phi_c) * mp.chi;
       return pick(zero < f, f, zero);
     };
-    // P = K log_near_one(phi / phi_d): log_series's operations lane by lane where |q - 1| is in
-    // its reach, else the library's log (the lanes in `needed`; the others keep whatever the
-    // series gives there)
+    // P = K log_near_one(phi / phi_d): log_series in every lane where |q - 1| is in its reach,
+    // else the library's log (the lanes in `needed`; the others keep whatever the series gives)
     auto pressure_of = [&](const V& pd, const M& needed) {
       const V q = phi / pd, x = q - 1.0;
       const M series = (x <= kLogSeriesReach) & (x >= -kLogSeriesReach);
-      const V y = x / (2.0 + x), y2 = y * y;
-      V s = fma4(y2, splat(1.0 / 13.0), splat(1.0 / 11.0));
-      s = fma4(s, y2, splat(1.0 / 9.0));
-      s = fma4(s, y2, splat(1.0 / 7.0));
-      s = fma4(s, y2, splat(1.0 / 5.0));
-      s = fma4(s, y2, splat(1.0 / 3.0));
-      V pressure = mp.K * fma4(2.0 * y, y2 * s, 2.0 * y);
+      V pressure = mp.K * log_series(x, [](const V& a, const V& b, const V& c) { return fma4(a, b, c); });
       for (int l = 0; l < 4; ++l)
         if (!series[l] && needed[l]) pressure[l] = mp.K * std::log(q[l]);
       return pressure;
