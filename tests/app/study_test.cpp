@@ -221,29 +221,34 @@ TEST_F(StudyCli, StoppedStudyKeepsFinishedRungsAndFinishesOnRerun) {
   const std::string cmd = furrow::cli_test::quote(FURROW_CLI_PATH) + " study " +
                           furrow::cli_test::quote(path("tiny.json")) +
                           " --ladder domain.dx_m=0.01,0.005,0.0025 --quiet --out " + furrow::cli_test::quote(out);
-  const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    ::execl("/bin/sh", "sh", "-c", ("exec " + cmd + " >/dev/null 2>&1").c_str(), (char*)nullptr);
-    ::_exit(127);
+  // Start it and stop it once the two cheap rungs are in the table (the finest takes several times
+  // longer). On a loaded machine the finest can still beat the stop: then start afresh, up to 3 times.
+  int status = 0, ok = 0;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    fs::remove_all(out);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      ::execl("/bin/sh", "sh", "-c", ("exec " + cmd + " >/dev/null 2>&1").c_str(), (char*)nullptr);
+      ::_exit(127);
+    }
+    bool two_done = false;
+    for (int i = 0; i < 600 && !two_done; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (!fs::exists(fs::path(out) / "study.csv")) continue;
+      int done = 0;
+      for (const auto& row : read_csv(fs::path(out) / "study.csv").rows)
+        done += row.count("status") && row.at("status") == "ok";
+      two_done = done >= 2;
+    }
+    ::kill(pid, two_done ? SIGTERM : SIGKILL);
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(two_done);
+    ok = 0;
+    for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) ok += row.at("status") == "ok";
+    if (ok < 3) break;
   }
-  // stop it once the two cheap rungs are in the table (the finest one takes several times longer)
-  bool two_done = false;
-  for (int i = 0; i < 600 && !two_done; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    if (!fs::exists(fs::path(out) / "study.csv")) continue;
-    int ok = 0;
-    for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) ok += row.count("status") && row.at("status") == "ok";
-    two_done = ok >= 2;
-  }
-  ASSERT_TRUE(two_done);
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  const Table t = read_csv(fs::path(out) / "study.csv");
-  int ok = 0;
-  for (const auto& row : t.rows) ok += row.at("status") == "ok";
-  if (ok == 3) GTEST_SKIP() << "the last rung finished before the stop arrived";
+  if (ok == 3) GTEST_SKIP() << "three times the last rung finished before the stop arrived";
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130);
   EXPECT_EQ(ok, 2);
   for (const auto& e : fs::directory_iterator(out))
