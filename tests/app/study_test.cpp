@@ -223,6 +223,11 @@ TEST_F(StudyCli, StoppedStudyKeepsFinishedRungsAndFinishesOnRerun) {
                           " --ladder domain.dx_m=0.01,0.005,0.0025 --quiet --out " + furrow::cli_test::quote(out);
   // Start it and stop it once the two cheap rungs are in the table (the finest takes several times
   // longer). On a loaded machine the finest can still beat the stop: then start afresh, up to 3 times.
+  auto ok_rungs = [&] {
+    int n = 0;
+    for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) n += row.count("status") && row.at("status") == "ok";
+    return n;
+  };
   int status = 0, ok = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
     fs::remove_all(out);
@@ -235,17 +240,12 @@ TEST_F(StudyCli, StoppedStudyKeepsFinishedRungsAndFinishesOnRerun) {
     bool two_done = false;
     for (int i = 0; i < 600 && !two_done; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      if (!fs::exists(fs::path(out) / "study.csv")) continue;
-      int done = 0;
-      for (const auto& row : read_csv(fs::path(out) / "study.csv").rows)
-        done += row.count("status") && row.at("status") == "ok";
-      two_done = done >= 2;
+      two_done = fs::exists(fs::path(out) / "study.csv") && ok_rungs() >= 2;
     }
     ::kill(pid, two_done ? SIGTERM : SIGKILL);
     ::waitpid(pid, &status, 0);
     ASSERT_TRUE(two_done);
-    ok = 0;
-    for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) ok += row.at("status") == "ok";
+    ok = ok_rungs();
     if (ok < 3) break;
   }
   if (ok == 3) GTEST_SKIP() << "three times the last rung finished before the stop arrived";
