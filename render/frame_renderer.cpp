@@ -456,19 +456,23 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
     // fill the panel but leave a little air above the chart title
     p.chart->SetLayoutStrategy(vtkChart::FILL_RECT);
     p.chart->SetSize(vtkRectf(0.f, 0.f, float(W - fa_w), float(H - std::lround(0.03 * H))));
-    p.chart->SetTitle(fp.title);
     p.chart->GetTitleProperties()->SetFontSize(title_px - 2);
     p.chart->GetTitleProperties()->SetColor(text_rgb);
-    double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
-    bool any = false;
+    const ForceAxes axes = force_panel_axes(fp);
+    std::string title = fp.title;
+    // the unit of the force axis, from its label's closing parentheses ("resisting force (N/m)")
+    std::string unit;
+    if (const size_t open = fp.y_label.rfind('('); open != std::string::npos && fp.y_label.back() == ')')
+      unit = " " + fp.y_label.substr(open + 1, fp.y_label.size() - open - 2);
+    for (double v : {axes.clipped_hi, axes.clipped_lo})
+      if (std::isfinite(v)) {
+        char note[96];
+        std::snprintf(note, sizeof note, "\n(%s %.4g%s off the chart)", v > 0 ? "peak" : "low", v, unit.c_str());
+        title += note;
+      }
+    p.chart->SetTitle(title);
     for (size_t s = 0; s < fp.series.size(); ++s) {
       const ForceSeries& ser = fp.series[s];
-      for (size_t k = 0; k < std::min(ser.x.size(), ser.y.size()); ++k) {
-        if (!std::isfinite(ser.x[k]) || !std::isfinite(ser.y[k])) continue;
-        if (!any) x_lo = x_hi = ser.x[k], y_lo = y_hi = ser.y[k], any = true;
-        x_lo = std::min(x_lo, ser.x[k]), x_hi = std::max(x_hi, ser.x[k]);
-        y_lo = std::min(y_lo, ser.y[k]), y_hi = std::max(y_hi, ser.y[k]);
-      }
       const auto& c = kSeriesColors[s % 4];
       auto line_t = make_xy_table(fp.x_label, ser.label.empty() ? "body " + std::to_string(s) : ser.label);
       auto mark_t = make_xy_table(fp.x_label, "now");
@@ -487,19 +491,14 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
       p.line_tables.push_back(line_t);
       p.marker_tables.push_back(mark_t);
     }
-    // fixed axes over the whole series, so the plot does not jump between frames
-    y_lo = std::min(y_lo, 0.0);
-    if (!any || x_hi <= x_lo) x_hi = x_lo + 1.0;
-    if (!any || y_hi <= y_lo) y_hi = y_lo + 1.0;
-    const double y_pad = 0.05 * (y_hi - y_lo);
     vtkAxis* ax = p.chart->GetAxis(vtkAxis::BOTTOM);
     vtkAxis* ay = p.chart->GetAxis(vtkAxis::LEFT);
     ax->SetTitle(fp.x_label);
     ay->SetTitle(fp.y_label);
     ax->SetBehavior(vtkAxis::FIXED);
     ay->SetBehavior(vtkAxis::FIXED);
-    ax->SetRange(x_lo, x_hi);
-    ay->SetRange(y_lo < 0 ? y_lo - y_pad : y_lo, y_hi + y_pad);
+    ax->SetRange(axes.x_lo, axes.x_hi);
+    ay->SetRange(axes.y_lo, axes.y_hi);
     for (vtkAxis* a : {ax, ay}) {
       a->GetTitleProperties()->SetFontSize(label_px);
       a->GetTitleProperties()->SetColor(text_rgb);
@@ -509,6 +508,37 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
     p.chart->SetShowLegend(fp.series.size() > 1);
     if (fp.series.size() > 1) p.chart->GetLegend()->GetLabelProperties()->SetFontSize(label_px - 2);
   }
+}
+
+ForceAxes force_panel_axes(const ForcePanel& fp) {
+  ForceAxes a;
+  std::vector<double> ys;
+  bool any = false;
+  for (const ForceSeries& ser : fp.series)
+    for (size_t k = 0; k < std::min(ser.x.size(), ser.y.size()); ++k) {
+      if (!std::isfinite(ser.x[k]) || !std::isfinite(ser.y[k])) continue;
+      if (!any) a.x_lo = a.x_hi = ser.x[k], any = true;
+      a.x_lo = std::min(a.x_lo, ser.x[k]), a.x_hi = std::max(a.x_hi, ser.x[k]);
+      ys.push_back(ser.y[k]);
+    }
+  if (!any || a.x_hi <= a.x_lo) a.x_hi = a.x_lo + 1.0;
+  if (ys.empty()) return a;
+  std::sort(ys.begin(), ys.end());
+  const double lo = std::min(ys.front(), 0.0), hi = ys.back();
+  double top = hi, bottom = lo;
+  // a percentile says something only with a few hundred samples; fewer are all drawn
+  if (ys.size() >= 200) {
+    const double q_lo = std::min(ys[size_t(0.005 * double(ys.size() - 1))], 0.0);
+    const double q_hi = ys[size_t(0.995 * double(ys.size() - 1))];
+    const double span = q_hi - q_lo;
+    if (span > 0 && hi > q_hi + 0.5 * span) top = q_hi + 0.25 * span, a.clipped_hi = hi;
+    if (span > 0 && lo < q_lo - 0.5 * span) bottom = q_lo - 0.25 * span, a.clipped_lo = lo;
+  }
+  if (top <= bottom) top = bottom + 1.0;
+  const double pad = 0.05 * (top - bottom);
+  a.y_lo = bottom < 0 ? bottom - pad : bottom;
+  a.y_hi = top + pad;
+  return a;
 }
 
 FrameRenderer::~FrameRenderer() = default;

@@ -5,6 +5,7 @@
 #pragma once
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,6 +67,18 @@ struct ForcePanel {
   std::string y_label = "resisting force (N/m)";
   std::vector<ForceSeries> series;
 };
+
+// The panel's axes, fixed over the whole series so the plot does not jump between frames. The
+// force axis fits the trace, not a start-up impulse: a body started at full speed inside a bed
+// pushes 6x its steady drag for a step (cylinder_drag: 114 against 19 N/m), which left the trace
+// in the bottom sixth of the panel. When the largest (smallest) values stand more than half the
+// trace's span beyond its 99.5th (0.5th) percentile, the axis stops a quarter span past that
+// percentile and `clipped_hi` (`clipped_lo`) holds the value off the chart (NaN otherwise).
+struct ForceAxes {
+  double x_lo = 0, x_hi = 1, y_lo = 0, y_hi = 1;
+  double clipped_hi = std::numeric_limits<double>::quiet_NaN(), clipped_lo = std::numeric_limits<double>::quiet_NaN();
+};
+ForceAxes force_panel_axes(const ForcePanel& panel);
 
 struct FrameStyle {
   int width = 1280, height = 720;  // even sizes for movies

@@ -217,6 +217,42 @@ TEST(FrameRenderer, ForcePanelGrowsWithTime) {
   EXPECT_GT(n_late, n_early + 100) << "the curve must extend as time advances";
 }
 
+// A steady drag of 19 N/m with a start-up impulse of 114 N/m in its first step (cylinder_drag's
+// trace): the axis fits the trace and names the impulse; a trace that rises to its end, or one of
+// too few samples for a percentile, keeps all of it in view.
+TEST(FrameRenderer, ForceAxisFitsTheTraceNotAStartUpImpulse) {
+  auto panel_of = [](std::vector<double> y) {
+    ForcePanel panel;
+    ForceSeries s;
+    for (size_t k = 0; k < y.size(); ++k) s.x.push_back(0.01 * double(k)), s.t_s.push_back(1e-3 * double(k));
+    s.y = std::move(y);
+    panel.series.push_back(s);
+    return panel;
+  };
+  std::vector<double> steady(2000);
+  for (size_t k = 0; k < steady.size(); ++k) steady[k] = 19.0 + std::sin(0.1 * double(k));
+  steady[0] = 114.0;
+  const ForceAxes a = force_panel_axes(panel_of(steady));
+  EXPECT_EQ(a.clipped_hi, 114.0);
+  EXPECT_TRUE(std::isnan(a.clipped_lo));
+  EXPECT_EQ(a.y_lo, 0.0);                    // a resisting force's axis starts at zero
+  EXPECT_GT(a.y_hi, 20.0);                   // the whole steady trace in view
+  EXPECT_LT(a.y_hi, 0.5 * 114.0);            // the trace fills more than half the panel
+  EXPECT_NEAR(a.x_hi, 0.01 * 1999, 1e-12);
+
+  std::vector<double> rising(2000);
+  for (size_t k = 0; k < rising.size(); ++k) rising[k] = 50.0 * std::sqrt(double(k));
+  const ForceAxes b = force_panel_axes(panel_of(rising));
+  EXPECT_TRUE(std::isnan(b.clipped_hi));
+  EXPECT_GE(b.y_hi, rising.back());
+
+  std::vector<double> few(100, 19.0);
+  few[0] = 114.0;
+  const ForceAxes c = force_panel_axes(panel_of(few));
+  EXPECT_TRUE(std::isnan(c.clipped_hi));
+  EXPECT_GE(c.y_hi, 114.0);
+}
+
 TEST(FrameRenderer, RejectsUnknownFieldListingValidOnes) {
   FrameStyle style;
   style.field = "temperature";
