@@ -510,16 +510,18 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
   }
 }
 
-ForceAxes force_panel_axes(const ForcePanel& fp) {
+ForceAxes force_panel_axes(const ForcePanel& fp) { return force_axes(fp.series.data(), fp.series.size()); }
+
+ForceAxes force_axes(const ForceSeries* series, size_t count) {
   ForceAxes a;
   std::vector<double> ys;
   bool any = false;
-  for (const ForceSeries& ser : fp.series)
-    for (size_t k = 0; k < std::min(ser.x.size(), ser.y.size()); ++k) {
-      if (!std::isfinite(ser.x[k]) || !std::isfinite(ser.y[k])) continue;
-      if (!any) a.x_lo = a.x_hi = ser.x[k], any = true;
-      a.x_lo = std::min(a.x_lo, ser.x[k]), a.x_hi = std::max(a.x_hi, ser.x[k]);
-      ys.push_back(ser.y[k]);
+  for (const ForceSeries* ser = series; ser != series + count; ++ser)
+    for (size_t k = 0; k < std::min(ser->x.size(), ser->y.size()); ++k) {
+      if (!std::isfinite(ser->x[k]) || !std::isfinite(ser->y[k])) continue;
+      if (!any) a.x_lo = a.x_hi = ser->x[k], any = true;
+      a.x_lo = std::min(a.x_lo, ser->x[k]), a.x_hi = std::max(a.x_hi, ser->x[k]);
+      ys.push_back(ser->y[k]);
     }
   if (!any || a.x_hi <= a.x_lo) a.x_hi = a.x_lo + 1.0;
   if (ys.empty()) return a;

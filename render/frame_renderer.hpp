@@ -79,6 +79,7 @@ struct ForceAxes {
   double clipped_hi = std::numeric_limits<double>::quiet_NaN(), clipped_lo = std::numeric_limits<double>::quiet_NaN();
 };
 ForceAxes force_panel_axes(const ForcePanel& panel);
+ForceAxes force_axes(const ForceSeries* series, size_t count);  // the same over `count` series
 
 struct FrameStyle {
   int width = 1280, height = 720;  // even sizes for movies

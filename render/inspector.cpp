@@ -453,8 +453,9 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
     for (const ForceSeries& ser : fp.series) {
       if (ser.x.size() < 2) continue;
       const auto [xmin, xmax] = std::minmax_element(ser.x.begin(), ser.x.end());
-      const auto [ymin, ymax] = std::minmax_element(ser.y.begin(), ser.y.end());
-      const double lo = std::min(0.0, *ymin), hi = *ymax > lo ? *ymax : lo + 1.0;
+      // the movie panel's force axis (a start-up impulse off the chart, named below)
+      const ForceAxes axes = force_axes(&ser, 1);
+      const double lo = axes.y_lo, hi = axes.y_hi;
       const std::vector<float> ys = resample(ser, 120, *xmin, *xmax);
       ImGui::Text("%s: %s", ser.label.c_str(), fp.y_label.c_str());
       ImGui::PlotLines("##force", ys.data(), int(ys.size()), 0, nullptr, float(lo), float(hi),
@@ -467,6 +468,8 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
       ImGui::GetWindowDrawList()->AddLine(ImVec2(px, r0.y), ImVec2(px, r1.y), IM_COL32(255, 200, 0, 255), 2.0f);
       ImGui::Text("%s: %.4g .. %.4g", fp.x_label.c_str(), *xmin, *xmax);
       ImGui::Text("force %.4g .. %.4g", lo, hi);
+      if (std::isfinite(axes.clipped_hi)) ImGui::Text("peak %.4g off the chart", axes.clipped_hi);
+      if (std::isfinite(axes.clipped_lo)) ImGui::Text("low %.4g off the chart", axes.clipped_lo);
     }
     ImGui::Separator();
   }
