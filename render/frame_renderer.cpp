@@ -464,10 +464,10 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
     std::string unit;
     if (const size_t open = fp.y_label.rfind('('); open != std::string::npos && fp.y_label.back() == ')')
       unit = " " + fp.y_label.substr(open + 1, fp.y_label.size() - open - 2);
-    for (double v : {axes.clipped_hi, axes.clipped_lo})
+    for (const auto& [what, v] : {std::pair{"peak", axes.clipped_hi}, std::pair{"low", axes.clipped_lo}})
       if (std::isfinite(v)) {
         char note[96];
-        std::snprintf(note, sizeof note, "\n(%s %.4g%s off the chart)", v > 0 ? "peak" : "low", v, unit.c_str());
+        std::snprintf(note, sizeof note, "\n(%s %.4g%s off the chart)", what, v, unit.c_str());
         title += note;
       }
     p.chart->SetTitle(title);

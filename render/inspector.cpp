@@ -452,21 +452,20 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
     const ForcePanel& fp = *s.forces;
     for (const ForceSeries& ser : fp.series) {
       if (ser.x.size() < 2) continue;
-      const auto [xmin, xmax] = std::minmax_element(ser.x.begin(), ser.x.end());
-      // the movie panel's force axis (a start-up impulse off the chart, named below)
+      // the movie panel's axes (a start-up impulse off the chart, named below)
       const ForceAxes axes = force_axes(&ser, 1);
-      const double lo = axes.y_lo, hi = axes.y_hi;
-      const std::vector<float> ys = resample(ser, 120, *xmin, *xmax);
+      const double lo = axes.y_lo, hi = axes.y_hi, xmin = axes.x_lo, xmax = axes.x_hi;
+      const std::vector<float> ys = resample(ser, 120, xmin, xmax);
       ImGui::Text("%s: %s", ser.label.c_str(), fp.y_label.c_str());
       ImGui::PlotLines("##force", ys.data(), int(ys.size()), 0, nullptr, float(lo), float(hi),
                        ImVec2(width - 20, 0.28f * height));
       const ImVec2 r0 = ImGui::GetItemRectMin(), r1 = ImGui::GetItemRectMax();
       const ImVec2 pad = ImGui::GetStyle().FramePadding;
       const double x_now = x_at_time(ser, s.frame.time_s);
-      const double u = (*xmax > *xmin) ? (x_now - *xmin) / (*xmax - *xmin) : 0.0;
+      const double u = (xmax > xmin) ? (x_now - xmin) / (xmax - xmin) : 0.0;
       const float px = r0.x + pad.x + float(u) * (r1.x - r0.x - 2 * pad.x);
       ImGui::GetWindowDrawList()->AddLine(ImVec2(px, r0.y), ImVec2(px, r1.y), IM_COL32(255, 200, 0, 255), 2.0f);
-      ImGui::Text("%s: %.4g .. %.4g", fp.x_label.c_str(), *xmin, *xmax);
+      ImGui::Text("%s: %.4g .. %.4g", fp.x_label.c_str(), xmin, xmax);
       ImGui::Text("force %.4g .. %.4g", lo, hi);
       if (std::isfinite(axes.clipped_hi)) ImGui::Text("peak %.4g off the chart", axes.clipped_hi);
       if (std::isfinite(axes.clipped_lo)) ImGui::Text("low %.4g off the chart", axes.clipped_lo);

@@ -237,7 +237,7 @@ TEST(FrameRenderer, ForceAxisFitsTheTraceNotAStartUpImpulse) {
   EXPECT_TRUE(std::isnan(a.clipped_lo));
   EXPECT_EQ(a.y_lo, 0.0);                    // a resisting force's axis starts at zero
   EXPECT_GT(a.y_hi, 20.0);                   // the whole steady trace in view
-  EXPECT_LT(a.y_hi, 0.5 * 114.0);            // the trace fills more than half the panel
+  EXPECT_LT(a.y_hi, 0.5 * 114.0);            // the axis ends under half the impulse
   EXPECT_NEAR(a.x_hi, 0.01 * 1999, 1e-12);
 
   std::vector<double> rising(2000);
