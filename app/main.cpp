@@ -7,6 +7,7 @@
 
 #include "app/cli.hpp"
 #include "app/mpi_sweep.hpp"
+#include "engine/simulation.hpp"
 
 using namespace furrow;
 
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
               << "\nparticle state: "
               << (FURROW_FLOAT_STATE ? "float stress, pressure, mass, affine matrix, strain rate (FURROW_FLOAT_STATE=ON)"
                                      : "double (FURROW_FLOAT_STATE=OFF)")
-              << "\n";
+              << "\ninstruction set: " << furrow::instruction_set() << "\n";
     return 0;
   }
   const cli::Command* cmd = nullptr;

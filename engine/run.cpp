@@ -489,6 +489,7 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
                    {"every_steps", Simulation::kReorderSteps}};
   j["state_bytes_per_particle"] = sim.particles().size() ? double(sim.state_bytes()) / sim.particles().size() : 0.0;
   j["state_precision"] = FURROW_FLOAT_STATE ? "float stress, pressure, mass, affine matrix, strain rate" : "double";
+  j["instruction_set"] = instruction_set();
   j["frames"] = frame_index;
   j["lead_body_travel_m"] = sim.lead_body_travel_m();
   j["units"] = {{"force", "N/m (per metre out of plane)"}, {"time", "s"}, {"length", "m"}};

@@ -72,6 +72,38 @@ inline Vec4d splat(double v) { return Vec4d{v, v, v, v}; }
 inline Vec4d lane(const Vec4d& v, int l) { return (Vec4d)_mm256_broadcast_sd(&v[l]); }  // v[l] in every lane
 #endif
 
+// P2G's sum over a run of consecutive points with the same stencil (the reorder sorts them
+// together, ~4 a run): the run's points add into registers and the grid takes the sum once, not a
+// read-modify-write of every node for every point. Pays only with AVX-512's 32 vector registers
+// (-15% P2G time); AVX2's 16 spill the twelve sums and it breaks even (README, Performance).
+template <int N> struct StencilRun {
+  static_assert(N <= 4, "a stencil row's vy0 is one Vec4d");
+  Vec4d four[N][N];  // node (a, b)'s [m vx vy vx0]
+  Vec4d fifth[N];    // row b's vy0, node a in lane a
+  GridNode* column0 = nullptr;  // the stencil's first node
+  size_t NY;
+  explicit StencilRun(size_t ny) : NY(ny) {}
+  // the point's stencil starts at `first`: a new stencil first hands the old run to the grid
+  void start(GridNode* first) __attribute__((always_inline)) {
+    if (first == column0) return;
+    flush();
+    column0 = first;
+    for (int a = 0; a < N; ++a) {
+      fifth[a] = Vec4d{0, 0, 0, 0};
+      for (int b = 0; b < N; ++b) four[a][b] = Vec4d{0, 0, 0, 0};
+    }
+  }
+  void flush() __attribute__((always_inline)) {
+    if (!column0) return;
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b) {
+        GridNode& n = column0[size_t(a) * NY + size_t(b)];
+        four_at(&n.m) += four[a][b];
+        n.vy0 += fifth[b][a];
+      }
+  }
+};
+
 #if defined(__AVX__)
 typedef float Vec4f __attribute__((vector_size(16)));
 // Four consecutive values as doubles, and back (a float array rounds each once, as a scalar store).
@@ -343,6 +375,16 @@ void Simulation::sample_body_fields() {
   body_node_full_kg_ = density * dx * dx;  // the field at a node whose whole stencil it fills
 }
 
+const char* instruction_set() {
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+  return "x86-64-v4 (AVX-512)";
+#elif defined(__AVX2__) && defined(__FMA__)
+  return "x86-64-v3 (AVX2, FMA)";
+#else
+  return "x86-64";
+#endif
+}
+
 void Simulation::step() {
   using clock = std::chrono::steady_clock;
   auto mark = clock::now();
@@ -422,6 +464,7 @@ void Simulation::particles_to_grid() {
     const auto *const PRESSURE = P.pressure.data();
     const double* const VOL = P.volume.data();
     const double h = dx, ih = inv_dx, dt_ = dt, Dinv_ = Dinv;
+    StencilRun<K::N> run(NY);
     for (uint32_t p = strip_start_[s], p_end = strip_start_[s + 1]; p < p_end; ++p) {
       double wx[K::N], wy[K::N], dwx[K::N], dwy[K::N];
       const double xp = X[p], yp = Y[p];
@@ -449,7 +492,9 @@ void Simulation::particles_to_grid() {
         // along a row only and dyp down a column only, so the column factors are formed once per
         // particle, U_a = wx_a (base + dxp_a colA) and V_a = wx_a colB, and each node takes
         // wy_b U_a + (wy_b dyp_b) V_a: two FMAs. The fifth field (force impulse y) the same way.
-        // Same sums as the scalar path, associated differently (round-off; README, Performance).
+        // Consecutive points with the same stencil (the reorder sorts them together) sum into
+        // `run`, which the grid takes once (Run). Same sums as the scalar path, associated
+        // differently (round-off; README, Performance).
         const Vec4d base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
         Vec4d Ua[K::N], Va[K::N];
         double u[K::N], v[K::N];
@@ -460,12 +505,12 @@ void Simulation::particles_to_grid() {
           u[a] = wx[a] * dxp * s01;
           v[a] = wx[a] * s11;
         }
+        run.start(nodes + Grid::index(bx, by, NY));
         for (int b = 0; b < K::N; ++b) {
-          GridNode* const row = nodes + Grid::index(bx, by + b, NY);
           const double wb = wy[b], wdb = wy[b] * (dy0 + b * h);
           for (int a = 0; a < K::N; ++a) {
-            four_at(&row[a * NY].m) += fma4(splat(wb), Ua[a], wdb * Va[a]);
-            row[a * NY].vy0 += fma1(wb, u[a], wdb * v[a]);
+            run.four[a][b] += fma4(splat(wb), Ua[a], wdb * Va[a]);
+            run.fifth[b][a] += fma1(wb, u[a], wdb * v[a]);
           }
         }
         continue;
@@ -499,6 +544,7 @@ void Simulation::particles_to_grid() {
         }
       }
     }
+    run.flush();
   };
   const int strips = int(strip_start_.size()) - 1;
 #if defined(__AVX__)
@@ -538,6 +584,7 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
   const size_t NY = size_t(g_.NY);
   const Particles& P = p_;
   const V zero = {0, 0, 0, 0};
+  StencilRun<3> run(NY);
   // points k..k+3 of the strip; count: a std::integral_constant 4 for a full group (plain loads),
   // a size_t for the strip's last, whose empty lanes take its last point and scatter nothing.
   // Inlined, so the grid's address and stride stay in registers across the scatter's stores.
@@ -568,24 +615,21 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
     }
     // scatter_strip's column factors U_a = wx_a (base + dxp_a colA), V_a = wx_a colB, field by field
     // for the four points, then turned into a [m vx vy vx0] vector per point (a 4x4 transpose); the
-    // fifth field's nine node terms for the four points at once
-    V Ua[3][4], Va[3][4], fifth[3][3];
+    // fifth field's u_a, v_a as a vector over a per point, for StencilRun's rows
+    V Ua[3][4], Va[3][4], uT[4], vT[4];
     for (int a = 0; a < 3; ++a) {
       transpose4(wx[a] * fma4(dxp[a], zero, m), wx[a] * fma4(dxp[a], q00, mvx), wx[a] * fma4(dxp[a], q10, mvy),
                  wx[a] * fma4(dxp[a], s00, zero), Ua[a]);
       transpose4(wx[a] * zero, wx[a] * q01, wx[a] * q11, wx[a] * s01, Va[a]);
-      for (int b = 0; b < 3; ++b) fifth[a][b] = fma4(wy[b], u[a], wdy[b] * v[a]);
     }
+    transpose4(u[0], u[1], u[2], zero, uT);
+    transpose4(v[0], v[1], v[2], zero, vT);
     for (size_t l = 0; l < count; ++l) {
-      GridNode* const column0 = nodes + Grid::index(bx[l], by[l], NY);
-      GridNode* const column[3] = {column0, column0 + NY, column0 + 2 * NY};
+      run.start(nodes + Grid::index(bx[l], by[l], NY));
       for (int b = 0; b < 3; ++b) {
         const V wb = lane(wy[b], int(l)), wdb = lane(wdy[b], int(l));
-        for (int a = 0; a < 3; ++a) {
-          GridNode& n = column[a][b];
-          four_at(&n.m) += fma4(wb, Ua[a][l], wdb * Va[a][l]);
-          n.vy0 += fifth[a][b][l];
-        }
+        for (int a = 0; a < 3; ++a) run.four[a][b] += fma4(wb, Ua[a][l], wdb * Va[a][l]);
+        run.fifth[b] += fma4(wb, uT[l], wdb * vT[l]);
       }
     }
   };
@@ -593,6 +637,7 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
   uint32_t k = k0;
   for (; k + 4 <= k1; k += 4) group(k, std::integral_constant<size_t, 4>());
   if (k < k1) group(k, size_t(k1 - k));
+  run.flush();
 #else
   (void)strip;
 #endif
@@ -1445,8 +1490,9 @@ void Simulation::advance_bodies() {
   }
 }
 
-// Physically reorder particle arrays by strip, then by cell row and column within it, so P2G and
-// G2P walk memory in order and each strip's points are one range (strip_start_).
+// Physically reorder particle arrays by strip, then by stencil row and column within it, so P2G and
+// G2P walk memory in order, each strip's points are one range (strip_start_) and points with the
+// same stencil are consecutive (P2G's StencilRun).
 template <class K>
 void Simulation::reorder_particles() {
   using W = StripWindow<K>;
@@ -1461,7 +1507,7 @@ void Simulation::reorder_particles() {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const int base = K::base(p_.x[i] * inv), strip = W::of_base(base, strips);
       const int column = std::clamp(base - W::width * (strip - 1), 0, W::width - 1);
-      const int cy = std::clamp(int(std::floor(p_.y[i] * inv)) + Grid::kPad, 0, rows - 1);
+      const int cy = std::clamp(K::base(p_.y[i] * inv) + Grid::kPad, 0, rows - 1);
       key[i] = uint32_t((size_t(strip) * rows + cy) * W::width + column);
     }
   });

@@ -274,4 +274,8 @@ class Simulation {
   std::unique_ptr<tbb::task_arena> arena_;
 };
 
+// The instruction set this engine was compiled for (CMake picks the build machine's widest):
+// --version and run.json say it, since the sums' round-off depends on it.
+const char* instruction_set();
+
 }  // namespace furrow
