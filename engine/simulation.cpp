@@ -493,7 +493,7 @@ void Simulation::particles_to_grid() {
         // particle, U_a = wx_a (base + dxp_a colA) and V_a = wx_a colB, and each node takes
         // wy_b U_a + (wy_b dyp_b) V_a: two FMAs. The fifth field (force impulse y) the same way.
         // Consecutive points with the same stencil (the reorder sorts them together) sum into
-        // `run`, which the grid takes once (Run). Same sums as the scalar path, associated
+        // `run`, which the grid takes once (StencilRun). Same sums as the scalar path, associated
         // differently (round-off; README, Performance).
         const Vec4d base = {m, mvx, mvy, 0.0}, colA = {0.0, q00, q10, s00}, colB = {0.0, q01, q11, s01};
         Vec4d Ua[K::N], Va[K::N];
