@@ -208,6 +208,27 @@ bool in_average_window(const Outputs& out, double t_s, double travel_m) {
   return t_s >= out.average_from_s && (out.average_to_s < 0.0 || t_s <= out.average_to_s);
 }
 
+FlowHoles count_flow_holes(const FieldFrame& f, const std::string& field, double flow_threshold,
+                           double hole_threshold) {
+  const auto it = f.scalars.find(field);
+  if (it == f.scalars.end()) throw std::invalid_argument("count_flow_holes: the frame holds no field '" + field + "'");
+  const std::vector<float>& v = it->second;
+  FlowHoles h;
+  for (int j = 0; j < f.ny; ++j)
+    for (int i = 0; i < f.nx; ++i) {
+      if (!f.active[f.index(i, j)]) continue;
+      double sum = 0;
+      int n = 0;
+      for (int b = std::max(j - 1, 0); b <= std::min(j + 1, f.ny - 1); ++b)
+        for (int a = std::max(i - 1, 0); a <= std::min(i + 1, f.nx - 1); ++a)
+          if ((a != i || b != j) && f.active[f.index(a, b)]) sum += v[f.index(a, b)], ++n;
+      if (n < 3 || !(sum / n > flow_threshold)) continue;
+      ++h.flowing;
+      if (v[f.index(i, j)] < hole_threshold) ++h.holes;
+    }
+  return h;
+}
+
 double median_finite(std::vector<double> v) {
   v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
   if (v.empty()) return kNaN;

@@ -120,6 +120,18 @@ std::vector<double> doubles_from_json(const nlohmann::json& j);
 
 bool in_average_window(const Outputs& out, double t_s, double travel_m);
 
+// ---------------------------------------------------------------- holes in a flowing zone
+// How continuous a stored field reads: among active cells whose active neighbours (of the 8 around
+// them, at least 3) average above `flow_threshold`, the `holes` that hold less than
+// `hole_threshold` themselves (a flowing zone's cell that reads as still: a speck in the movie).
+struct FlowHoles {
+  int64_t flowing = 0, holes = 0;
+  double fraction() const { return flowing > 0 ? double(holes) / double(flowing) : 0.0; }
+};
+// Throws std::invalid_argument when the frame does not hold the scalar `field`.
+FlowHoles count_flow_holes(const FieldFrame& frame, const std::string& field, double flow_threshold = 0.05,
+                           double hole_threshold = 1e-3);
+
 // ---------------------------------------------------------------- rigid wedge under a plate
 struct WedgeOptions {
   double tolerance = 0.1;   // |v - v_plate| < tolerance |v_plate| counts as moving with the plate

@@ -142,23 +142,37 @@ FieldFrame rasterize(const ParticleView& p, const RasterSpec& spec,
     f.velocity_y.assign(ncell, 0.0f);
   }
 
+  // quadratic B-spline of an offset in cells (support 1.5 cells each side)
+  auto bspline = [](double d) {
+    d = std::fabs(d);
+    return d < 0.5 ? 0.75 - d * d : d < 1.5 ? 0.5 * (1.5 - d) * (1.5 - d) : 0.0;
+  };
+  const bool smooth = spec.transfer == RasterTransfer::quadratic_bspline;
+  const int reach = smooth ? 1 : 0;  // neighbour cells whose points can weigh on a cell
   tbb::parallel_for(tbb::blocked_range<size_t>(0, ncell, 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t c = r.begin(); c != r.end(); ++c) {
-      if (start[c] == start[c + 1]) continue;
+      if (start[c] == start[c + 1]) continue;  // holds no point: inactive
+      const int ci = int(c % size_t(spec.nx)), cj = int(c / size_t(spec.nx));
+      const double xc = spec.origin_m.x() + (ci + 0.5) * spec.dx_m, yc = spec.origin_m.y() + (cj + 0.5) * spec.dx_m;
       double m = 0, vol = 0, grain_vol = 0, mvx = 0, mvy = 0, mq[kMaxAveraged] = {};
-      for (uint32_t s = start[c]; s < start[c + 1]; ++s) {
-        const uint32_t k = order[s];
-        const double mk = p.mass_kg[k];
-        m += mk;
-        vol += p.volume_m2[k];
-        if (want_packing) grain_vol += p.grain_density_kg_m3[k] * p.volume_m2[k];
-        if (want_velocity) {
-          mvx += mk * p.vx_m_s[k];
-          mvy += mk * p.vy_m_s[k];
+      for (int nj = std::max(cj - reach, 0); nj <= std::min(cj + reach, spec.ny - 1); ++nj)
+        for (int ni = std::max(ci - reach, 0); ni <= std::min(ci + reach, spec.nx - 1); ++ni) {
+          const size_t nc = size_t(nj) * size_t(spec.nx) + size_t(ni);
+          for (uint32_t s = start[nc]; s < start[nc + 1]; ++s) {
+            const uint32_t k = order[s];
+            const double w = smooth ? bspline((p.x_m[k] - xc) * inv_dx) * bspline((p.y_m[k] - yc) * inv_dx) : 1.0;
+            const double mk = w * p.mass_kg[k];
+            m += mk;
+            vol += w * p.volume_m2[k];
+            if (want_packing) grain_vol += w * p.grain_density_kg_m3[k] * p.volume_m2[k];
+            if (want_velocity) {
+              mvx += mk * p.vx_m_s[k];
+              mvy += mk * p.vy_m_s[k];
+            }
+            for (int a = 0; a < navg; ++a) mq[a] += mk * averaged[a].second[k];
+          }
         }
-        for (int a = 0; a < navg; ++a) mq[a] += mk * averaged[a].second[k];
-      }
-      if (!(m > 0.0)) continue;  // no material: inactive
+      if (!(m > 0.0)) continue;  // massless points only: inactive
       f.active[c] = 1;
       if (out_packing) out_packing[c] = grain_vol > 0.0 ? float(m / grain_vol) : 0.0f;
       if (out_density) out_density[c] = vol > 0.0 ? float(m / vol) : 0.0f;

@@ -401,6 +401,7 @@ TEST(Rasterize, HydrostaticPressureIsLinearInDepthWithSlopeRhoG) {
 }
 
 TEST(Rasterize, AveragesAreMassWeighted) {
+  // (the per-cell transfer: each cell its own points; the B-spline one is display_fields_test's)
   // two particles in cell (1, 0) of a 3x1 grid with dx = 0.1, plus particles outside / invalid
   const double nan = std::nan("");
   std::vector<double> x = {0.12, 0.18, -0.05, 0.31, nan}, y = {0.05, 0.02, 0.05, 0.05, 0.05};
@@ -413,7 +414,8 @@ TEST(Rasterize, AveragesAreMassWeighted) {
   p.grain_density_kg_m3 = rho.data(), p.vx_m_s = vx.data(), p.vy_m_s = vy.data();
   p.strain_rate_1_s = sr.data();
   const FieldFrame f =
-      rasterize(p, {3, 1, 0.1, {0.0, 0.0}}, {"velocity", "strain_rate", "packing_fraction", "density"});
+      rasterize(p, {3, 1, 0.1, {0.0, 0.0}, RasterTransfer::cell_average},
+                {"velocity", "strain_rate", "packing_fraction", "density"});
   EXPECT_EQ(f.active, (std::vector<uint8_t>{0, 1, 0}));
   EXPECT_NEAR(f.velocity_x[1], (1.0 * 1 - 3.0 * 1) / 4, 1e-6);
   EXPECT_NEAR(f.velocity_y[1], (1.0 * 2) / 4, 1e-6);
