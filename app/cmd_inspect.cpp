@@ -48,7 +48,7 @@ int inspect_main(const Parsed& p) {
                                                                : render::parse_inspect_script(script);
 
   render::InspectorState state = render::open_run(run_dir, p.get("--field"));
-  render::InspectorView view(width, height, p.has("--smooth"));
+  render::InspectorView view(width, height, !p.has("--cells"));
   if (!headless) {
     render::WindowOptions w;
     w.script = steps, w.script_path = script, w.exit_after_script = p.has("--exit-after-script");
@@ -65,7 +65,7 @@ int inspect_main(const Parsed& p) {
 Command command_inspect() {
   return {"inspect",
           "inspect a stored run in a window, or replay a script headless: probe, profile, measure, screenshot",
-          "furrow inspect RUN_DIR [--headless] [--script FILE [--exit-after-script]] [--field NAME] [--size WxH] [--smooth]",
+          "furrow inspect RUN_DIR [--headless] [--script FILE [--exit-after-script]] [--field NAME] [--size WxH] [--cells]",
           std::string("Opens the frames stored in RUN_DIR (frames/*.vdb, forces.csv). In a window (a display is\n"
                       "needed): the frame and the inspector panel; pick the field and frame in the panel, click\n"
                       "on the bed to probe, Left/Right for the previous/next frame, S for a screenshot\n"
@@ -82,7 +82,8 @@ Command command_inspect() {
            {"--exit-after-script", false, false, "close the window once the script has run"},
            {"--field", true, false, "field selected at the start (default: strain_rate, else pressure, ...)", "NAME"},
            {"--size", true, false, "screenshot size (default 1280x720; the panel takes a third, up to 420 px)", "WxH"},
-           {"--smooth", false, false, "draw fields smoothed within the material (display only)"}},
+           {"--cells", false, false, "draw each cell as one flat colour (default: blended within the material)"},
+           {"--smooth", false, false, "blend fields within the material: the default, kept for old scripts"}},
           1,
           1,
           inspect_main};

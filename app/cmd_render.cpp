@@ -4,13 +4,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "app/commands.hpp"
 #include "engine/field_store.hpp"
+#include "engine/scene_io.hpp"
 #include "render/colormap.hpp"
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"
 #include "render/image_io.hpp"
+#include "render/layouts.hpp"
 #include "render/plot.hpp"
 #include "render/test_scene.hpp"
 
@@ -88,11 +91,7 @@ std::vector<std::string> spread(const std::vector<std::string>& v, size_t n) {
   return out;
 }
 
-std::string all_fields() {
-  std::string s;
-  for (const auto& f : field_registry()) s += (s.empty() ? "" : ", ") + f.name;
-  return s;
-}
+std::string all_fields() { return render::display_field_names(); }
 
 // Default outputs go to the next free name; a path the user gave is refused if taken (unless
 // --overwrite).
@@ -119,21 +118,22 @@ void apply_range_option(const std::string& spec, const std::string& field, rende
 
 std::string range_text(const std::string& field, const render::FieldRange& r) {
   char buf[160];
-  std::snprintf(buf, sizeof buf, "%s range %.4g..%.4g %s%s", field.c_str(), r.lo, r.hi, find_field(field)->unit.c_str(),
+  std::snprintf(buf, sizeof buf, "%s range %.4g..%.4g %s%s", field.c_str(), r.lo, r.hi, render::find_display_field(field)->unit.c_str(),
                 r.log ? " (log)" : "");
   return buf;
 }
 
 int render_main(const Parsed& p) {
-  const std::string run_dir = p.positional[0];
-  if (!fs::is_directory(run_dir)) {
-    std::cerr << "furrow render: run directory '" << run_dir << "' does not exist\n";
-    return 1;
-  }
+  const std::vector<std::string>& runs = p.positional;
+  for (const auto& run_dir : runs)
+    if (!fs::is_directory(run_dir)) {
+      std::cerr << "furrow render: run directory '" << run_dir << "' does not exist\n";
+      return 1;
+    }
   if (!p.has("--field")) throw UsageError("--field NAME[,NAME...] is required (fields: " + all_fields() + ")");
   const std::vector<std::string> fields = split(p.get("--field"), ',');
   for (size_t k = 0; k < fields.size(); ++k) {
-    if (!find_field(fields[k])) {
+    if (!render::find_display_field(fields[k])) {
       std::cerr << "furrow render: unknown field '" << fields[k] << "' in --field " << p.get("--field")
                 << " (valid fields: " << all_fields() << ")\n";
       return 2;
@@ -141,72 +141,181 @@ int render_main(const Parsed& p) {
     for (size_t j = 0; j < k; ++j)
       if (fields[j] == fields[k]) throw UsageError("--field: '" + fields[k] + "' is listed twice");
   }
-  const bool several = fields.size() > 1;
-  if (several && (p.has("--range") || p.has("--colormap")))
+  const bool several_runs = runs.size() > 1;
+  if (several_runs && fields.size() > 1)
+    throw UsageError("several runs side by side take one --field (got " + p.get("--field") + ")");
+  const bool several = fields.size() > 1 || several_runs;
+  if (fields.size() > 1 && (p.has("--range") || p.has("--colormap")))
     throw UsageError("--range and --colormap apply to a single --field");
   if (p.has("--png") && p.has("--contact-sheet")) throw UsageError("--png and --contact-sheet exclude each other");
   const bool sheet = p.has("--contact-sheet");
+  if (sheet && several_runs) throw UsageError("--contact-sheet takes one run");
+  if (sheet && (p.has("--frame-of") || p.has("--normalize")))
+    throw UsageError("--frame-of and --normalize apply to movies and --png");
+  std::vector<std::string> labels;
+  if (p.has("--labels")) {
+    labels = split(p.get("--labels"), ',');
+    if (labels.size() != runs.size())
+      throw UsageError("--labels: " + std::to_string(labels.size()) + " labels for " + std::to_string(runs.size()) +
+                       " runs");
+  }
+  const double zoom = p.has("--zoom") ? parse_number(p.get("--zoom"), "--zoom") : 1.0;
+  if (!(zoom >= 1.0 && zoom <= 50.0)) throw UsageError("--zoom must be in 1..50, got " + p.get("--zoom"));
+  if (p.has("--zoom") && !p.has("--frame-of")) throw UsageError("--zoom goes with --frame-of BODY");
 
   render::FrameStyle style;
   style.field = fields.front();
-  style.smooth = p.has("--smooth");
+  style.smooth = !p.has("--cells");
+  style.follow_body = p.get("--frame-of");
+  style.zoom = zoom;
   if (p.has("--colormap")) {
     style.colormap = p.get("--colormap");
     render::load_colormap(style.colormap);  // unknown name: error listing the known ones
   }
-  const double fps = p.has("--fps") ? parse_number(p.get("--fps"), "--fps") : 10.0;
+
+  // every run's frames, selected alike and paired by time
+  std::vector<std::vector<std::string>> run_frames;
+  for (const auto& run_dir : runs) {
+    const fs::path frames_dir = fs::path(run_dir) / "frames";
+    if (!fs::is_directory(frames_dir)) {
+      std::cerr << "furrow render: " << run_dir << " has no frames/ folder (is it a run directory from 'furrow run'?)\n";
+      return 1;
+    }
+    std::vector<std::string> frames = select_frames(list_frames(run_dir), p.get("--frames"));
+    if (frames.empty()) {
+      std::cerr << "furrow render: no frame_*.vdb files in " << frames_dir.string() << "\n";
+      return 1;
+    }
+    if (sheet && !p.has("--frames")) frames = spread(frames, 12);
+    run_frames.push_back(frames);
+  }
+  const std::vector<std::string>& frames = run_frames.front();
+  if (several_runs) {
+    size_t n = frames.size();
+    for (const auto& r : run_frames) n = std::min(n, r.size());
+    const FieldFrame first = read_frame(frames.front());
+    for (size_t r = 1; r < runs.size(); ++r) {
+      const FieldFrame other = read_frame(run_frames[r].front());
+      const double w0 = first.nx * first.dx_m, h0 = first.ny * first.dx_m;
+      const double w1 = other.nx * other.dx_m, h1 = other.ny * other.dx_m;
+      if (std::abs(w1 - w0) > 0.01 * w0 || std::abs(h1 - h0) > 0.01 * h0) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "the domains differ: %s is %.4g x %.4g m, %s is %.4g x %.4g m", runs[0].c_str(), w0,
+                      h0, runs[r].c_str(), w1, h1);
+        std::cerr << "furrow render: " << buf << "; side by side needs the same domain (dx may differ)\n";
+        return 1;
+      }
+      run_frames[r].resize(n);
+    }
+    run_frames.front().resize(n);
+    // frames pair by index; their times must agree (same frame interval and start)
+    for (size_t k = 0; k < n; ++k) {
+      const double t0 = read_frame(run_frames[0][k]).time_s;
+      for (size_t r = 1; r < runs.size(); ++r) {
+        const double t = read_frame(run_frames[r][k]).time_s;
+        const double gap = k > 0 ? t0 - read_frame(run_frames[0][k - 1]).time_s : t0;
+        if (std::abs(t - t0) > 1e-9 + 0.25 * std::abs(gap)) {
+          std::cerr << "furrow render: frames do not pair by time: " << run_frames[0][k] << " is at t = " << t0
+                    << " s, " << run_frames[r][k] << " at t = " << t << " s (store frames at the same interval)\n";
+          return 1;
+        }
+      }
+    }
+  }
+  // a body to follow must be in every run's frames before anything is written
+  if (!style.follow_body.empty())
+    for (const auto& r : run_frames) {
+      const FieldFrame f = read_frame(r.front());
+      std::string names;
+      bool found = false;
+      for (const auto& b : f.bodies) found |= b.name == style.follow_body, names += (names.empty() ? "" : ", ") + b.name;
+      if (!found) {
+        std::cerr << "furrow render: --frame-of: no body '" << style.follow_body << "' in " << r.front()
+                  << " (bodies: " << (names.empty() ? "none" : names) << ")\n";
+        return 1;
+      }
+    }
+  const double fps = p.has("--fps") ? parse_number(p.get("--fps"), "--fps") : render::movie_fps(frames.size());
   if (!(fps > 0)) throw UsageError("--fps must be > 0");
 
-  const fs::path frames_dir = fs::path(run_dir) / "frames";
-  if (!fs::is_directory(frames_dir)) {
-    std::cerr << "furrow render: " << run_dir << " has no frames/ folder (is it a run directory from 'furrow run'?)\n";
-    return 1;
-  }
-  std::vector<std::string> frames = select_frames(list_frames(run_dir), p.get("--frames"));
-  if (frames.empty()) {
-    std::cerr << "furrow render: no frame_*.vdb files in " << frames_dir.string() << "\n";
-    return 1;
-  }
-  if (sheet && !p.has("--frames")) frames = spread(frames, 12);
-
-  // one fixed range per field over the frames drawn
-  const std::vector<render::FrameScan> scans = render::scan_frames(frames, fields);
+  // one fixed range per panel over the frames drawn: several runs share one (same colours, same values)
   render::PanelsStyle panels_style;
   std::string ranges;
-  for (size_t k = 0; k < fields.size(); ++k) {
+  std::optional<render::FieldRange> shared;
+  std::string normalized;  // the scales drawn with, printed
+  if (several_runs) {
+    std::vector<std::string> all;
+    for (const auto& r : run_frames) all.insert(all.end(), r.begin(), r.end());
+    shared = render::scan_frames(all, fields.front()).range;
+  }
+  const std::vector<render::FrameScan> scans = render::scan_frames(frames, fields);
+  for (size_t k = 0; k < std::max(fields.size(), runs.size()); ++k) {
     render::FrameStyle s = style;
-    s.field = fields[k];
-    s.range = scans[k].range;
-    s.time_decimals = scans[k].time_decimals;
-    if (p.has("--range")) apply_range_option(p.get("--range"), fields[k], &s.range);
+    s.field = fields[several_runs ? 0 : k];
+    s.range = shared ? *shared : scans[k].range;
+    s.time_decimals = scans[several_runs ? 0 : k].time_decimals;
+    if (p.has("--range")) apply_range_option(p.get("--range"), s.field, &s.range);
+    if (several_runs) s.title = labels.empty() ? fs::path(runs[k]).filename().string() : labels[k];
+    if (k == 0 || !several_runs) ranges += (ranges.empty() ? "" : "; ") + range_text(s.field, s.range);
+    if (p.has("--normalize")) {
+      const fs::path scene_path = fs::path(runs[several_runs ? k : 0]) / "scene.json";
+      if (!fs::exists(scene_path))
+        throw std::runtime_error("--normalize: " + scene_path.string() + " does not exist (it names the body's speed and size)");
+      const render::BodyScales sc = render::body_scales(load_scene(scene_path.string()), scene_path.string());
+      render::normalize_style(sc, &s);
+      if (k == 0) normalized = render::scales_text(sc);
+    }
     panels_style.fields.push_back(s);
-    ranges += (ranges.empty() ? "" : "; ") + range_text(fields[k], s.range);
   }
   style = panels_style.fields.front();
-  const fs::path forces = fs::path(run_dir) / "forces.csv";
+  // a run's force panel: each body's trace averaged over one cell of travel, over its raw trace
+  auto panel_of = [&](size_t r) {
+    const render::ForcePanel raw = render::read_force_panel((fs::path(runs[r]) / "forces.csv").string());
+    if (p.has("--raw-force")) return raw;
+    const double dx_mm = 1000.0 * read_frame(run_frames[r].front()).dx_m;
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3g mm = 1 cell", dx_mm);
+    return render::with_running_mean(raw, dx_mm, text);
+  };
+  const fs::path forces = fs::path(runs.front()) / "forces.csv";
   if (!p.has("--no-panel") && !sheet && fs::exists(forces)) {
-    render::ForcePanel panel = render::read_force_panel(forces.string());
+    render::ForcePanel panel = panel_of(0);
+    // several runs: one trace per run, labelled like its panel
+    for (size_t r = 1; r < runs.size() && !panel.series.empty(); ++r) {
+      const fs::path f = fs::path(runs[r]) / "forces.csv";
+      if (!fs::exists(f)) continue;
+      for (auto s : panel_of(r).series) {
+        s.label = panels_style.fields[r].title + ": " + s.label;
+        panel.series.push_back(s);
+      }
+    }
+    if (several_runs)
+      for (size_t k = 0; k < panel.series.size() && panel.series[k].label.find(": ") == std::string::npos; ++k)
+        panel.series[k].label = panels_style.fields[0].title + ": " + panel.series[k].label;
     if (!panel.series.empty()) style.panel = panels_style.forces = panel;
   }
-  // default sizes: 1280x720; a sheet 1920 wide; several fields 640x480 per panel (the force plot
-  // is one more panel), on a sheet 1280x720 per field
-  const int panels = int(fields.size()) + (panels_style.forces ? 1 : 0);
+  // default sizes: 1280x720; a sheet 1920 wide; several panels 640x480 each (the force plot is one
+  // more panel), on a sheet 1280x720 per field
+  const int panels = int(panels_style.fields.size()) + (panels_style.forces ? 1 : 0);
   if (several) style.width = sheet ? 1280 * int(fields.size()) : 640 * panels, style.height = sheet ? 720 : 480;
   else if (sheet) style.width = 1920, style.height = 1080;
   if (p.has("--size")) parse_size(p.get("--size"), &style.width, &style.height);
   panels_style.width = style.width, panels_style.height = style.height;
 
-  std::string name;  // default output name: the fields joined by '-'
+  std::string name;  // default output name: the fields (several runs: and the labels) joined by '-'
   for (const auto& f : fields) name += (name.empty() ? "" : "-") + f;
+  if (several_runs)
+    for (const auto& s : panels_style.fields) name += "-" + s.title;
   bool overwrite = false;
   if (p.has("--png")) {
-    const std::string dir = choose_output(p, fs::path(run_dir) / "renders" / name, &overwrite);
-    const auto written = several ? render::render_pngs(frames, panels_style, dir, overwrite)
-                                 : render::render_pngs(frames, style, dir, overwrite);
+    const std::string dir = choose_output(p, fs::path(runs.front()) / "renders" / name, &overwrite);
+    const auto written = several_runs ? render::render_pngs(run_frames, panels_style, dir, overwrite)
+                         : several    ? render::render_pngs(frames, panels_style, dir, overwrite)
+                                      : render::render_pngs(frames, style, dir, overwrite);
     std::cout << dir << "  (" << written.size() << " PNG, " << style.width << "x" << style.height << ", " << ranges
-              << ")\n";
+              << (normalized.empty() ? "" : "; normalized by " + normalized) << ")\n";
   } else if (sheet) {
-    const std::string out = choose_output(p, fs::path(run_dir) / "renders" / (name + "_contact_sheet.png"), &overwrite);
+    const std::string out = choose_output(p, fs::path(runs.front()) / "renders" / (name + "_contact_sheet.png"), &overwrite);
     if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
     const int columns = p.has("--columns") ? int(parse_int(p.get("--columns"), "--columns")) : 0;
     if (columns < 0) throw UsageError("--columns must be >= 1");
@@ -219,12 +328,14 @@ int render_main(const Parsed& p) {
     if (style.width % 2 || style.height % 2)
       throw UsageError("--size: movies need even width and height (H.264, yuv420p), got " +
                        std::to_string(style.width) + "x" + std::to_string(style.height));
-    const std::string out = choose_output(p, fs::path(run_dir) / "movies" / (name + ".mp4"), &overwrite);
+    const std::string out = choose_output(p, fs::path(runs.front()) / "movies" / (name + ".mp4"), &overwrite);
     if (fs::path(out).has_parent_path()) fs::create_directories(fs::path(out).parent_path());
-    if (several) render::render_movie(frames, panels_style, out, fps, overwrite);
+    if (several_runs) render::render_movie(run_frames, panels_style, out, fps, overwrite);
+    else if (several) render::render_movie(frames, panels_style, out, fps, overwrite);
     else render::render_movie(frames, style, out, fps, overwrite);
     std::cout << out << "  (" << frames.size() << " frames at " << fps << " fps, " << style.width << "x"
-              << style.height << ", " << ranges << ")\n";
+              << style.height << ", " << ranges << (normalized.empty() ? "" : "; normalized by " + normalized) << "; poster " << fs::path(out).replace_extension(".png").string()
+              << ")\n";
   }
   return 0;
 }
@@ -311,7 +422,7 @@ void parse_size(const std::string& s, int* w, int* h) {
 Command command_render() {
   return {"render",
           "re-render stored frames to an MP4, PNGs or a contact sheet",
-          "furrow render RUN_DIR --field NAME[,NAME...] [--frames a:b[:step]] [--size WxH] [--png | --contact-sheet] [--out PATH]",
+          "furrow render RUN_DIR [RUN_DIR...] --field NAME[,NAME...] [--frames a:b[:step]] [--size WxH] [--png | --contact-sheet] [--out PATH]",
           "Draws fields of the frames stored in RUN_DIR/frames/*.vdb, off-screen (no display needed).\n"
           "Several fields (--field strain_rate,pressure,packing_fraction) are drawn side by side, each\n"
           "with its own colour range and colorbar (default size 640x480 per panel, the force plot being\n"
@@ -319,13 +430,26 @@ Command command_render() {
           "The colour range is fixed over all selected frames (min..max over cells with material; strain\n"
           "rate on a log scale from max/10^4 up to its max) unless --range is given. Cells without material\n"
           "are grey, bodies are outlined in cyan, and each image carries a colorbar with the field's unit and\n"
-          "the time stamp. Each cell is one flat colour unless --smooth blends the values between cell\n"
-          "centres within the material (cells without material stay grey, so the free surface stays sharp). Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
+          "the time stamp. The field is drawn at about the image's resolution, blended between cell centres\n"
+          "within the material (its edge within half a cell of the cells with material); --cells draws\n"
+          "each cell as one flat colour instead. Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
           "for each body, the resisting force -F.d (d = unit direction of its travel from first to last\n"
-          "position; Fy for a plate pushed down) against its displacement from its first position.\n"
+          "position; Fy for a plate pushed down) against its displacement from its first position,\n"
+          "drawn as its running mean over one cell of travel over the faint raw trace (--raw-force: raw only).\n"
+          "\n"
+          "Several runs (furrow render RUN_A RUN_B --field strain_rate --labels loose,dense) are drawn\n"
+          "side by side, one field, one colour range over all of them, each panel titled by its label and\n"
+          "the force panel carrying one trace per run; their frames pair by index and must agree in time\n"
+          "and domain (dx may differ). The paper's movie layouts:\n"
+          "  --frame-of BODY  centre every frame on BODY: it stays still and the bed moves past it\n"
+          "                   (--zoom F enlarges the view about it)\n"
+          "  --normalize      velocity over the moving body's speed v, strain rate over v/L (L its size\n"
+          "                   across its travel), time as t v/L; v and L come from RUN_DIR/scene.json and\n"
+          "                   are printed in the title\n"
           "\n"
           "Outputs (default: a movie):\n"
-          "  movie            RUN_DIR/movies/<field>.mp4 (H.264, yuv420p; even sizes)\n"
+          "  movie            RUN_DIR/movies/<field>.mp4 (H.264, yuv420p, faststart: plays in browsers;\n"
+          "                   even sizes; ~10 s long unless --fps), its last frame as <field>.png beside it\n"
           "  --png            RUN_DIR/renders/<field>/frame_NNNNN.png, one per frame\n"
           "  --contact-sheet  RUN_DIR/renders/<field>_contact_sheet.png: up to 12 frames spread over the run\n"
           "                  (<field> is the fields joined by '-' when there are several)\n"
@@ -345,11 +469,17 @@ Command command_render() {
            {"--overwrite", false, false, "replace an existing output"},
            {"--range", true, false, "fixed colour range instead of the frames' min..max (one field only)", "LO:HI"},
            {"--colormap", true, false, "viridis, magma or coolwarm (default: by field; one field only)", "NAME"},
-           {"--fps", true, false, "movie frames per second (default 10)", "N"},
+           {"--fps", true, false, "movie frames per second (default: the frames over 10 s, 2..30)", "N"},
+           {"--labels", true, false, "panel titles of several runs, comma-separated (default: folder names)", "LIST"},
+           {"--frame-of", true, false, "follow this body: it stays still in the image", "BODY"},
+           {"--zoom", true, false, "with --frame-of: enlarge the view about the body (1..50, default 1)", "F"},
+           {"--normalize", false, false, "dimensionless velocity (/v), strain rate (/(v/L)) and time (t v/L)"},
            {"--no-panel", false, false, "leave out the force panel"},
-           {"--smooth", false, false, "blend values between cell centres within the material (display only)"}},
+           {"--raw-force", false, false, "force panel: every step only (default: one cell's running mean over it)"},
+           {"--cells", false, false, "draw each cell as one flat colour (default: blended within the material)"},
+           {"--smooth", false, false, "blend values within the material: the default, kept for old scripts"}},
           1,
-          1,
+          8,
           render_main};
 }
 

@@ -1,5 +1,6 @@
 #include "app/run_movies.hpp"
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -15,7 +16,10 @@ void render_run_movies(const std::string& run_dir, const Scene& scene, bool quie
   if (scene.outputs.movies.empty()) return;
   const auto paths = list_frames(run_dir);
   if (paths.empty()) return;
-  const render::ForcePanel panel = render::read_force_panel((fs::path(run_dir) / "forces.csv").string());
+  char window[64];
+  std::snprintf(window, sizeof window, "%.3g mm = 1 cell", 1000.0 * scene.domain.dx_m);
+  const render::ForcePanel panel = render::with_running_mean(
+      render::read_force_panel((fs::path(run_dir) / "forces.csv").string()), 1000.0 * scene.domain.dx_m, window);
   fs::create_directories(fs::path(run_dir) / "movies");
   for (const auto& field : scene.outputs.movies) {
     const render::FrameScan scan = render::scan_frames(paths, field);
@@ -25,7 +29,7 @@ void render_run_movies(const std::string& run_dir, const Scene& scene, bool quie
     style.time_decimals = scan.time_decimals;
     if (!panel.series.empty()) style.panel = panel;
     const std::string out = (fs::path(run_dir) / "movies" / (field + ".mp4")).string();
-    render::render_movie(paths, style, out, 10.0, false);
+    render::render_movie(paths, style, out, render::movie_fps(paths.size()), false);
     if (!quiet) std::cerr << "movie: " << out << " (" << paths.size() << " frames)\n";
   }
 }

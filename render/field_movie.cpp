@@ -46,31 +46,77 @@ std::vector<std::string> field_names(const PanelsStyle& style) {
 }
 
 using DrawFrame = std::function<RgbImage(const FieldFrame&)>;
+using DrawIndex = std::function<RgbImage(size_t)>;  // the k-th image of a sequence
+
+// The poster beside a movie: movies/strain_rate.mp4 -> movies/strain_rate.png.
+std::string poster_path(const std::string& movie_path) {
+  return (fs::path(movie_path).parent_path() / (fs::path(movie_path).stem().string() + ".png")).string();
+}
+
+void movie_of(size_t count, int width, int height, const DrawIndex& draw, const std::string& out_path, double fps,
+              bool overwrite, const FrameProgress& progress) {
+  if (count == 0) throw std::runtime_error(out_path + ": no frames to put in the movie");
+  const std::string poster = poster_path(out_path);
+  if (!overwrite && fs::exists(poster))
+    throw std::runtime_error(poster + ": already exists (the movie's poster would go there); not overwriting it");
+  MovieWriter movie(out_path, width, height, fps, overwrite);
+  RgbImage last;
+  for (size_t k = 0; k < count; ++k) {
+    last = draw(k);
+    movie.add_frame(last);
+    if (progress) progress(k + 1, count);
+  }
+  movie.finish();
+  write_png(last, poster, overwrite);  // the last frame: the whole force trace, the flow developed
+}
 
 void movie_of(const std::vector<std::string>& paths, const std::vector<std::string>& fields, int width, int height,
               const DrawFrame& draw, const std::string& out_path, double fps, bool overwrite,
               const FrameProgress& progress) {
-  if (paths.empty()) throw std::runtime_error(out_path + ": no frames to put in the movie");
-  MovieWriter movie(out_path, width, height, fps, overwrite);
-  for (size_t k = 0; k < paths.size(); ++k) {
-    movie.add_frame(draw(read_with_fields(paths[k], fields)));
-    if (progress) progress(k + 1, paths.size());
+  movie_of(
+      paths.size(), width, height, [&](size_t k) { return draw(read_with_fields(paths[k], fields)); }, out_path, fps,
+      overwrite, progress);
+}
+
+std::vector<std::string> pngs_of(const std::vector<std::string>& names, const DrawIndex& draw,
+                                 const std::string& out_dir, bool overwrite, const FrameProgress& progress) {
+  fs::create_directories(out_dir);
+  std::vector<std::string> written;
+  for (size_t k = 0; k < names.size(); ++k) {
+    const std::string out = (fs::path(out_dir) / (fs::path(names[k]).stem().string() + ".png")).string();
+    write_png(draw(k), out, overwrite);
+    written.push_back(out);
+    if (progress) progress(k + 1, names.size());
   }
-  movie.finish();
+  return written;
 }
 
 std::vector<std::string> pngs_of(const std::vector<std::string>& paths, const std::vector<std::string>& fields,
                                  const DrawFrame& draw, const std::string& out_dir, bool overwrite,
                                  const FrameProgress& progress) {
-  fs::create_directories(out_dir);
-  std::vector<std::string> written;
-  for (size_t k = 0; k < paths.size(); ++k) {
-    const std::string out = (fs::path(out_dir) / (fs::path(paths[k]).stem().string() + ".png")).string();
-    write_png(draw(read_with_fields(paths[k], fields)), out, overwrite);
-    written.push_back(out);
-    if (progress) progress(k + 1, paths.size());
-  }
-  return written;
+  return pngs_of(
+      paths, [&](size_t k) { return draw(read_with_fields(paths[k], fields)); }, out_dir, overwrite, progress);
+}
+
+// Frame k of every run, each checked for its panel's field.
+DrawIndex draw_runs(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style,
+                    PanelsRenderer& renderer) {
+  return [&runs, &style, &renderer](size_t k) {
+    std::vector<FieldFrame> frames;
+    for (size_t r = 0; r < runs.size(); ++r) frames.push_back(read_with_fields(runs[r][k], {style.fields[r].field}));
+    std::vector<const FieldFrame*> ptrs;
+    for (const auto& f : frames) ptrs.push_back(&f);
+    return renderer.render(ptrs);
+  };
+}
+
+void check_runs(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style) {
+  if (runs.empty() || runs.size() != style.fields.size())
+    throw std::invalid_argument(std::to_string(runs.size()) + " runs for " + std::to_string(style.fields.size()) +
+                                " panels");
+  for (const auto& r : runs)
+    if (r.size() != runs.front().size())
+      throw std::invalid_argument("side-by-side runs need the same number of frames each");
 }
 }  // namespace
 
@@ -199,6 +245,29 @@ RgbImage render_contact_sheet(const std::vector<std::string>& paths, const Panel
                  uint8_t(std::lround(255 * bg[2])));
   for (int k = 0; k < n; ++k) sheet.blit(blocks[size_t(k)], k * block_w, 0);
   return sheet;
+}
+
+}  // namespace furrow::render
+
+namespace furrow::render {
+
+double movie_fps(size_t frames) {
+  return std::clamp(double(frames) / kMovieSeconds, 2.0, 30.0);
+}
+
+void render_movie(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style,
+                  const std::string& out_path, double fps, bool overwrite, const FrameProgress& progress) {
+  check_runs(runs, style);
+  PanelsRenderer renderer(style);
+  movie_of(runs.front().size(), style.width, style.height, draw_runs(runs, style, renderer), out_path, fps, overwrite,
+           progress);
+}
+
+std::vector<std::string> render_pngs(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style,
+                                     const std::string& out_dir, bool overwrite, const FrameProgress& progress) {
+  check_runs(runs, style);
+  PanelsRenderer renderer(style);
+  return pngs_of(runs.front(), draw_runs(runs, style, renderer), out_dir, overwrite, progress);
 }
 
 }  // namespace furrow::render

@@ -27,14 +27,28 @@ int time_decimals_for(const std::vector<double>& times_s);
 
 using FrameProgress = std::function<void(size_t done, size_t total)>;
 
+// Frames per second that make a movie of `frames` frames last about kMovieSeconds (5-20 s for
+// 10-600 frames; at least 2 and at most 30 frames per second).
+constexpr double kMovieSeconds = 10.0;
+double movie_fps(size_t frames);
+
 // Renders every frame with `style` and encodes them at `fps` into `out_path` (see MovieWriter:
-// even sizes, atomic publish, no overwrite unless asked).
+// H.264 yuv420p with faststart, even sizes, atomic publish, no overwrite unless asked), and writes
+// the last image as a poster PNG beside it (movies/strain_rate.mp4 -> movies/strain_rate.png;
+// refused up front when that file exists and overwrite is off).
 void render_movie(const std::vector<std::string>& frame_paths, const FrameStyle& style, const std::string& out_path,
                   double fps, bool overwrite, const FrameProgress& progress = {});
 
 // The same with several fields side by side (PanelsRenderer); style.width/height is the movie's size.
 void render_movie(const std::vector<std::string>& frame_paths, const PanelsStyle& style, const std::string& out_path,
                   double fps, bool overwrite, const FrameProgress& progress = {});
+
+// Several runs side by side: panel k of `style` draws run k's frames (runs[k], the same count for
+// every run; the caller pairs them by time). Poster as above.
+void render_movie(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style,
+                  const std::string& out_path, double fps, bool overwrite, const FrameProgress& progress = {});
+std::vector<std::string> render_pngs(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style,
+                                     const std::string& out_dir, bool overwrite, const FrameProgress& progress = {});
 
 // One PNG per frame in `out_dir` (created if missing), named like the frame file
 // (frame_00042.vdb -> frame_00042.png). Returns the paths written.

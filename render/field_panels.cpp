@@ -41,12 +41,19 @@ PanelsRenderer::PanelsRenderer(const PanelsStyle& style) : style_(style) {
 PanelsRenderer::~PanelsRenderer() = default;
 
 RgbImage PanelsRenderer::render(const FieldFrame& frame) {
+  return render(std::vector<const FieldFrame*>(fields_.size(), &frame));
+}
+
+RgbImage PanelsRenderer::render(const std::vector<const FieldFrame*>& frames) {
+  if (frames.size() != fields_.size())
+    throw std::invalid_argument(std::to_string(frames.size()) + " frames for " + std::to_string(fields_.size()) +
+                                " side-by-side panels");
   const auto& bg = style_.fields.front().background_rgb;
   RgbImage out(style_.width, style_.height, uint8_t(std::lround(255 * bg[0])), uint8_t(std::lround(255 * bg[1])),
                uint8_t(std::lround(255 * bg[2])));
-  for (size_t k = 0; k < fields_.size(); ++k) out.blit(fields_[k]->render(frame), panel_x0(k), 0);
+  for (size_t k = 0; k < fields_.size(); ++k) out.blit(fields_[k]->render(*frames[k]), panel_x0(k), 0);
   if (forces_) {
-    const RgbImage full = forces_->render(frame);
+    const RgbImage full = forces_->render(*frames.front());
     RgbImage plot(panel_w_, style_.height);
     plot.blit(full, -forces_->layout().panel_x0, 0);
     out.blit(plot, panel_x0(fields_.size()), 0);

@@ -1,6 +1,7 @@
-// Several fields of one frame side by side (strain rate | pressure | packing fraction), as the
-// paper's figures show them: each panel a FrameRenderer with its own colour range, colormap,
-// colorbar and unit; the force-vs-displacement plot, when given, as one more panel on the right.
+// Several fields of one frame side by side (strain rate | pressure | packing fraction), or one
+// field of several runs side by side (an under- and an over-compacted bed), as the paper's figures
+// and movies show them: each panel a FrameRenderer with its own colour range, colormap, colorbar
+// and unit; the force-vs-displacement plot, when given, as one more panel on the right.
 #pragma once
 #include <memory>
 #include <optional>
@@ -28,6 +29,9 @@ class PanelsRenderer {
   PanelsRenderer& operator=(const PanelsRenderer&) = delete;
 
   RgbImage render(const FieldFrame& frame);
+  // Side-by-side runs: panel k draws frames[k] (one per panel); the force plot follows frames[0]'s
+  // time. Throws std::invalid_argument when the count differs from the panels'.
+  RgbImage render(const std::vector<const FieldFrame*>& frames);
   size_t field_count() const { return fields_.size(); }
   // Left edge of field panel k in the image, and its layout (pixels within the panel).
   int panel_x0(size_t k) const { return int(k) * panel_w_; }

@@ -1,5 +1,7 @@
 #include "render/force_series.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -96,6 +98,32 @@ ForcePanel read_force_panel(const std::string& path) {
     panel.series.push_back(std::move(out));
   }
   return panel;
+}
+
+ForcePanel with_running_mean(const ForcePanel& panel, double window, const std::string& window_text) {
+  if (!(window > 0) || panel.x_label.rfind("displacement", 0) != 0) return panel;
+  ForcePanel out = panel;
+  out.series.clear();
+  for (const ForceSeries& raw : panel.series) {
+    ForceSeries mean = raw;
+    const size_t n = std::min(raw.x.size(), raw.y.size());
+    // travel only grows along a body's straight path: a sliding window of +-window/2 with sums
+    std::vector<double> sum(n + 1, 0.0);
+    for (size_t k = 0; k < n; ++k) sum[k + 1] = sum[k] + raw.y[k];
+    size_t lo = 0, hi = 0;
+    for (size_t k = 0; k < n; ++k) {
+      while (lo < k && raw.x[lo] < raw.x[k] - 0.5 * window) ++lo;
+      if (hi < k + 1) hi = k + 1;
+      while (hi < n && raw.x[hi] <= raw.x[k] + 0.5 * window) ++hi;
+      mean.y[k] = (sum[hi] - sum[lo]) / double(hi - lo);
+    }
+    ForceSeries faint = raw;
+    faint.faint = true;
+    out.series.push_back(faint);
+    out.series.push_back(mean);
+  }
+  out.title = panel.title + "\n(line: mean over " + window_text + " of travel; faint: every step)";
+  return out;
 }
 
 }  // namespace furrow::render

@@ -51,16 +51,15 @@ namespace furrow::render {
 
 // ---- field values and ranges --------------------------------------------------------------------
 namespace {
-std::string valid_field_list() {
-  std::string s;
-  for (const auto& f : field_registry()) s += (s.empty() ? "" : ", ") + f.name;
-  return s;
+const FieldInfo& require_field(const std::string& field) {
+  const FieldInfo* info = find_display_field(field);
+  if (!info) throw std::invalid_argument("unknown field '" + field + "' (valid fields: " + display_field_names() + ")");
+  return *info;
 }
 
-const FieldInfo& require_field(const std::string& field) {
-  const FieldInfo* info = find_field(field);
-  if (!info) throw std::invalid_argument("unknown field '" + field + "' (valid fields: " + valid_field_list() + ")");
-  return *info;
+// velocity_x -> 0, velocity_y -> 1, anything else -> -1
+int velocity_component(const std::string& field) {
+  return field == "velocity_x" ? 0 : field == "velocity_y" ? 1 : -1;
 }
 
 std::string frame_fields(const FieldFrame& f) {
@@ -71,18 +70,44 @@ std::string frame_fields(const FieldFrame& f) {
 }
 }  // namespace
 
+const std::vector<FieldInfo>& display_fields() {
+  static const std::vector<FieldInfo> fields = [] {
+    std::vector<FieldInfo> f = field_registry();
+    f.push_back({"velocity_x", "m/s", "Horizontal velocity", false, false, false});
+    f.push_back({"velocity_y", "m/s", "Vertical velocity", false, false, false});
+    return f;
+  }();
+  return fields;
+}
+
+const FieldInfo* find_display_field(const std::string& name) {
+  for (const auto& f : display_fields())
+    if (f.name == name) return &f;
+  return nullptr;
+}
+
+std::string display_field_names() {
+  std::string s;
+  for (const auto& f : display_fields()) s += (s.empty() ? "" : ", ") + f.name;
+  return s;
+}
+
 std::vector<float> field_values(const FieldFrame& frame, const std::string& field) {
   const FieldInfo& info = require_field(field);
   const size_t n = size_t(frame.nx) * size_t(frame.ny);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::vector<float> out(n, nan);
   const bool has_mask = frame.active.size() == n;
-  if (info.vector) {
+  const int component = velocity_component(field);
+  if (info.vector || component >= 0) {
     if (frame.velocity_x.size() != n || frame.velocity_y.size() != n)
       throw std::runtime_error("frame at step " + std::to_string(frame.step) + " has no field 'velocity' (it has: " +
                                frame_fields(frame) + ")");
     for (size_t k = 0; k < n; ++k)
-      if (!has_mask || frame.active[k]) out[k] = std::hypot(frame.velocity_x[k], frame.velocity_y[k]);
+      if (!has_mask || frame.active[k])
+        out[k] = component == 0 ? frame.velocity_x[k]
+                 : component == 1 ? frame.velocity_y[k]
+                                  : std::hypot(frame.velocity_x[k], frame.velocity_y[k]);
     return out;
   }
   auto it = frame.scalars.find(field);
@@ -152,6 +177,8 @@ FieldRange RangeAccumulator::range() const {
     return r;
   }
   r.lo = robust_lo_, r.hi = robust_hi_;
+  // a signed component on a diverging map: zero at the map's neutral centre
+  if (velocity_component(field_) >= 0 && r.lo < 0 && r.hi > 0) r.hi = std::max(r.hi, -r.lo), r.lo = -r.hi;
   if (r.hi - r.lo <= 1e-12 * std::max(1.0, std::abs(r.hi))) {
     const double pad = std::abs(r.hi) > 0 ? 0.05 * std::abs(r.hi) : 1.0;
     r.lo -= pad, r.hi += pad;
@@ -292,7 +319,9 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
   p.to_colors->SetInputData(p.image);
   p.image_actor->GetMapper()->SetInputConnection(p.to_colors->GetOutputPort());
   p.image_actor->GetMapper()->BorderOn();  // cells are squares: draw the outer half cells too
-  p.image_actor->InterpolateOff();         // one flat colour per cell: resolution stays visible
+  // flat cells show the resolution; smoothed, the texels blend into a continuous image
+  if (style.smooth) p.image_actor->InterpolateOn();
+  else p.image_actor->InterpolateOff();
   p.field_ren->AddActor(p.image_actor);
 
   p.outline_mapper->SetInputData(p.outlines);
@@ -375,7 +404,8 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
     p.bar->GetCellData()->SetScalars(rgb);
     // ticks at round values (render/ticks.hpp), labelled in a prefixed unit (kPa)
     const int max_ticks = std::clamp((cb_x1 - cb_x0) / (7 * label_px), 3, 6);
-    const Ticks ticks = choose_ticks(style.range.lo, style.range.hi, max_ticks, style.range.log, require_field(style.field).unit);
+    const Ticks ticks = choose_ticks(style.range.lo, style.range.hi, max_ticks, style.range.log,
+                                     style.value_title.empty() ? require_field(style.field).unit : "-");
     vtkNew<vtkPoints> tick_pts;
     vtkNew<vtkCellArray> tick_lines;
     for (size_t k = 0; k < ticks.values.size(); ++k) {
@@ -414,7 +444,9 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
     }
     p.tick_actor->GetProperty()->SetColor(text_rgb);
     p.tick_actor->GetProperty()->SetLineWidth(float(std::max(1.0, 1.5 * font_scale)));
-    p.colorbar_title->SetInput(colorbar_title(style.field, style.range.log, ticks.unit).c_str());
+    const std::string cb_title = style.value_title.empty() ? colorbar_title(style.field, style.range.log, ticks.unit)
+                                 : style.value_title + (style.range.log ? " (log scale)" : "");
+    p.colorbar_title->SetInput(cb_title.c_str());
     vtkTextProperty* tp = p.colorbar_title->GetTextProperty();
     tp->SetFontSize(title_px - 2);
     tp->SetColor(text_rgb);
@@ -471,15 +503,24 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
         title += note;
       }
     p.chart->SetTitle(title);
+    size_t colour = 0;  // a faint raw trace takes the colour of the series drawn over it
     for (size_t s = 0; s < fp.series.size(); ++s) {
       const ForceSeries& ser = fp.series[s];
-      const auto& c = kSeriesColors[s % 4];
+      std::array<unsigned char, 3> c = kSeriesColors[colour % 4];
+      if (ser.faint)
+        for (auto& ch : c) ch = (unsigned char)std::lround(0.35 * ch + 0.65 * 255);
+      else
+        ++colour;
       auto line_t = make_xy_table(fp.x_label, ser.label.empty() ? "body " + std::to_string(s) : ser.label);
       auto mark_t = make_xy_table(fp.x_label, "now");
       vtkPlot* line = p.chart->AddPlot(vtkChart::LINE);
       line->SetInputData(line_t, 0, 1);
       line->SetColor(c[0], c[1], c[2], 255);
-      line->SetWidth(float(std::max(1.5, 2.5 * font_scale)));
+      line->SetWidth(float(ser.faint ? std::max(1.0, 1.2 * font_scale) : std::max(1.5, 2.5 * font_scale)));
+      line->SetLegendVisibility(!ser.faint);
+      p.line_tables.push_back(line_t);
+      p.marker_tables.push_back(mark_t);
+      if (ser.faint) continue;  // the marker sits on the series drawn over it
       vtkPlot* mark = p.chart->AddPlot(vtkChart::POINTS);
       mark->SetInputData(mark_t, 0, 1);
       mark->SetColor(c[0], c[1], c[2], 255);
@@ -488,8 +529,6 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
         pts->SetMarkerStyle(vtkPlotPoints::CIRCLE);
         pts->SetMarkerSize(float(std::max(6.0, 12.0 * font_scale)));
       }
-      p.line_tables.push_back(line_t);
-      p.marker_tables.push_back(mark_t);
     }
     vtkAxis* ax = p.chart->GetAxis(vtkAxis::BOTTOM);
     vtkAxis* ay = p.chart->GetAxis(vtkAxis::LEFT);
@@ -505,8 +544,8 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
       a->GetLabelProperties()->SetFontSize(label_px - 2);
       a->GetLabelProperties()->SetColor(text_rgb);
     }
-    p.chart->SetShowLegend(fp.series.size() > 1);
-    if (fp.series.size() > 1) p.chart->GetLegend()->GetLabelProperties()->SetFontSize(label_px - 2);
+    p.chart->SetShowLegend(colour > 1);
+    if (colour > 1) p.chart->GetLegend()->GetLabelProperties()->SetFontSize(label_px - 2);
   }
 }
 
@@ -553,6 +592,8 @@ RgbImage FrameRenderer::render(const FieldFrame& frame, const FrameOverlay* over
                                 std::to_string(frame.nx) + ", ny " + std::to_string(frame.ny) + ", dx " +
                                 std::to_string(frame.dx_m) + " m)");
   std::vector<float> v = field_values(frame, style_.field);
+  if (style_.value_scale != 1.0)
+    for (float& x : v) x = float(x * style_.value_scale);
   if (style_.range.log) {
     const float lo = float(style_.range.lo);
     for (float& x : v)
@@ -566,15 +607,34 @@ RgbImage FrameRenderer::render(const FieldFrame& frame, const FrameOverlay* over
   const int side = int(std::lround(0.025 * W));
   const double avail_w = fa_w - 2.0 * side, avail_h = double(H - top_band - bottom_band);
   const double bed_w = frame.nx * frame.dx_m, bed_h = frame.ny * frame.dx_m;
-  const double ppm = std::min(avail_w / bed_w, avail_h / bed_h);
+  const double ppm = std::min(avail_w / bed_w, avail_h / bed_h) * style_.zoom;
   layout_.px_per_m = ppm;
   layout_.bed_x0 = side + 0.5 * (avail_w - bed_w * ppm);
-  layout_.bed_x1 = layout_.bed_x0 + bed_w * ppm;
   layout_.bed_y0 = top_band + 0.5 * (avail_h - bed_h * ppm);
+  if (!style_.follow_body.empty()) {
+    // the body's position at the field area's centre: it stays put, the bed moves
+    const BodyOutline* body = nullptr;
+    std::string names;
+    for (const auto& b : frame.bodies) {
+      if (b.name == style_.follow_body) body = &b;
+      names += (names.empty() ? "" : ", ") + b.name;
+    }
+    if (!body)
+      throw std::runtime_error("frame at step " + std::to_string(frame.step) + " has no body '" + style_.follow_body +
+                               "' to follow (bodies: " + (names.empty() ? "none" : names) + ")");
+    layout_.bed_x0 = side + 0.5 * avail_w - (body->position_m.x() - frame.origin_m.x()) * ppm;
+    layout_.bed_y0 = top_band + 0.5 * avail_h + (body->position_m.y() - frame.origin_m.y()) * ppm - bed_h * ppm;
+  }
+  layout_.bed_x1 = layout_.bed_x0 + bed_w * ppm;
   layout_.bed_y1 = layout_.bed_y0 + bed_h * ppm;
   layout_.bed_origin_m = frame.origin_m;
-  // field texture: one image point per cell (or per sub-cell when smoothed), at its centre
-  const int sub = style_.smooth ? std::clamp(int(std::ceil(ppm * frame.dx_m / 2.0)), 2, 8) : 1;  // ~2 px each
+  // field texture: one image point per cell, or when smoothed per sub-cell of about one and a half
+  // pixels (drawn interpolated, so about the image's resolution), at most ~4 M texels
+  int sub = 1;
+  if (style_.smooth) {
+    const double cap = std::sqrt(4.0e6 / (double(frame.nx) * double(frame.ny)));
+    sub = std::clamp(int(std::ceil(ppm * frame.dx_m / 1.5)), 2, std::max(2, std::min(16, int(cap))));
+  }
   if (sub > 1) v = upsample_within_material(v, frame.nx, frame.ny, sub, style_.range.log);
   const double h = frame.dx_m / sub;
   p.image->SetDimensions(frame.nx * sub, frame.ny * sub, 1);
@@ -585,6 +645,17 @@ RgbImage FrameRenderer::render(const FieldFrame& frame, const FrameOverlay* over
   std::copy(v.begin(), v.end(), p.values->GetPointer(0));
   p.values->Modified();
   p.image->Modified();
+  {
+    // only the texels inside the field area: a followed or zoomed bed must not run under the
+    // title or the colorbar
+    const double tp = h * ppm;  // pixels per texel
+    const int mx = frame.nx * sub - 1, my = frame.ny * sub - 1;
+    const int i0 = std::clamp(int(std::floor((side - layout_.bed_x0) / tp)), 0, mx);
+    const int i1 = std::clamp(int(std::ceil((fa_w - side - layout_.bed_x0) / tp)) - 1, 0, mx);
+    const int j0 = std::clamp(int(std::floor((layout_.bed_y1 - (H - bottom_band)) / tp)), 0, my);
+    const int j1 = std::clamp(int(std::ceil((layout_.bed_y1 - top_band) / tp)) - 1, 0, my);
+    p.image_actor->SetDisplayExtent(i0, i1, j0, j1, 0, 0);
+  }
 
   // camera: world point under the centre of the field viewport; parallel scale = half its height
   const Eigen::Vector2d centre_m(frame.origin_m.x() + (0.5 * fa_w - layout_.bed_x0) / ppm,
@@ -635,13 +706,17 @@ RgbImage FrameRenderer::render(const FieldFrame& frame, const FrameOverlay* over
 
   // text
   if (style_.show_title) {
-    const std::string t = frame.scene_name.empty() ? colorbar_title(style_.field, false)
-                                                   : frame.scene_name + ": " + find_field(style_.field)->label;
+    const std::string t = !style_.title.empty()       ? style_.title
+                          : frame.scene_name.empty() ? colorbar_title(style_.field, false)
+                                                     : frame.scene_name + ": " + require_field(style_.field).label;
     p.title->SetInput(t.c_str());
   }
   if (style_.show_time) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "t = %.*f s", std::clamp(style_.time_decimals, 0, 9), frame.time_s);
+    if (style_.time_label.empty())
+      std::snprintf(buf, sizeof buf, "t = %.*f s", std::clamp(style_.time_decimals, 0, 9), frame.time_s);
+    else
+      std::snprintf(buf, sizeof buf, "%s = %.2f", style_.time_label.c_str(), frame.time_s * style_.time_scale);
     p.time->SetInput(buf);
   }
 

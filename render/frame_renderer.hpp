@@ -22,8 +22,15 @@ struct FieldRange {
   bool log = false;  // log10 mapping (strain rate); then 0 < lo < hi
 };
 
-// The values drawn for `field`: the scalar as stored, or |v| for velocity. Inactive cells are NaN.
-// Throws std::runtime_error if the frame does not hold the field (naming the ones it has).
+// What can be drawn: every stored field of field_registry(), plus the velocity's components
+// velocity_x and velocity_y (signed, read from the stored `velocity`).
+const std::vector<FieldInfo>& display_fields();
+const FieldInfo* find_display_field(const std::string& name);
+std::string display_field_names();  // "velocity, velocity_x, ..." for messages
+
+// The values drawn for `field` (a display field): the scalar as stored, |v| for velocity, or one
+// component. Inactive cells are NaN. Throws std::invalid_argument for an unknown field and
+// std::runtime_error if the frame does not hold it (naming the ones it has).
 std::vector<float> field_values(const FieldFrame& frame, const std::string& field);
 
 // Accumulates the range of a field over frames (active cells only).
@@ -58,6 +65,7 @@ std::string default_colormap(const std::string& field, const FieldRange& range);
 // Force against displacement of one body, sampled at times t_s (ascending).
 struct ForceSeries {
   std::string label;  // body name
+  bool faint = false;  // drawn light and thin behind the next series (its raw trace), no legend
   std::vector<double> t_s, x, y;  // x, y in the panel's display units
 };
 
@@ -92,9 +100,23 @@ struct FrameStyle {
   int time_decimals = 3;
   double font_scale = 0.0;  // text size relative to a 720-pixel-high image; 0: height / 720
   std::optional<ForcePanel> panel;  // side panel (right ~38% of the image)
-  // Display only: blend values between cell centres inside the material on a finer image
-  // (render/smooth.hpp); cells without material stay empty, so the free surface stays sharp.
-  bool smooth = false;
+  // Dimensionless display (furrow render --normalize): values drawn as value * value_scale under
+  // the colorbar title value_title (e.g. "Vertical velocity / v"), time as time_s * time_scale
+  // after time_label ("t v/L = 1.25"). Empty: the field's own label and unit, "t = ... s".
+  // `range` is in the drawn (scaled) values.
+  double value_scale = 1.0;
+  std::string value_title;
+  double time_scale = 1.0;
+  std::string time_label;
+  std::string title;  // replaces "<scene>: <field label>" (side-by-side runs carry their label)
+  // Follow a body (--frame-of): each frame is centred on this body's position, so the body stays
+  // still in the image and the bed moves past it; `zoom` multiplies the whole-bed scale.
+  std::string follow_body;
+  double zoom = 1.0;
+  // Display only: blend values between cell centres inside the material at about the image's
+  // resolution (render/smooth.hpp), the surface within half a cell of the cells with material.
+  // false draws each cell as one flat colour (the resolution visible).
+  bool smooth = true;
   std::array<float, 3> empty_rgb{0.82f, 0.82f, 0.82f};     // cells with no material
   std::array<float, 3> outline_rgb{0.0f, 0.9f, 1.0f};      // body outlines (cyan: in no colormap)
   std::array<float, 3> background_rgb{1.0f, 1.0f, 1.0f};

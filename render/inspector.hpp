@@ -122,7 +122,7 @@ struct ViewInput {
 // marked, last results) on the right, off-screen.
 class InspectorView {
  public:
-  InspectorView(int width, int height, bool smooth = false);
+  InspectorView(int width, int height, bool smooth = true);
   ~InspectorView();
   InspectorView(const InspectorView&) = delete;
   InspectorView& operator=(const InspectorView&) = delete;

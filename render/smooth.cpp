@@ -23,8 +23,6 @@ std::vector<float> upsample_within_material(const std::vector<float>& values, in
   auto at = [&](int i, int j) { return v[size_t(std::clamp(j, 0, ny - 1)) * size_t(nx) + size_t(std::clamp(i, 0, nx - 1))]; };
   for (int J = 0; J < fy; ++J)
     for (int I = 0; I < fx; ++I) {
-      const int ci = I / factor, cj = J / factor;
-      if (std::isnan(at(ci, cj))) continue;  // no material in this cell: stays empty
       // position in cell-centre coordinates (centre of cell i at i)
       const double x = (I + 0.5) / factor - 0.5, y = (J + 0.5) / factor - 0.5;
       const int i0 = int(std::floor(x)), j0 = int(std::floor(y));
@@ -37,8 +35,10 @@ std::vector<float> upsample_within_material(const std::vector<float>& values, in
           const double w = (a ? tx : 1 - tx) * (b ? ty : 1 - ty);
           sum += w * c, weight += w;
         }
-      const double blended = weight > 0 ? sum / weight : at(ci, cj);
-      out[size_t(J) * size_t(fx) + size_t(I)] = float(log ? std::pow(10.0, blended) : blended);
+      // the surface where the blended material indicator crosses one half: within half a cell
+      // of the cells' outline, and without its staircase
+      if (!(weight >= 0.5)) continue;
+      out[size_t(J) * size_t(fx) + size_t(I)] = float(log ? std::pow(10.0, sum / weight) : sum / weight);
     }
   return out;
 }

@@ -68,7 +68,8 @@ TEST(FrameRenderer, HydrostaticPressureColoursRiseMonotonicallyWithDepth) {
 
   // Down a vertical line at x = 0.08 m (clear of the plate), from 1 px below the free surface to
   // 1 px above the bottom: every pixel is a viridis colour, its index never decreases with depth,
-  // and it matches the cell's pressure (index = floor(256 p / p_max), within 2 for cell edges).
+  // and it matches the pressure at its depth (index = floor(256 p / p_max), within 2): drawn blended
+  // between cell centres, a linear field reads exactly, held at the outer cells' centres.
   const int px = int(L.to_pixel({0.08, 0.0}).x());
   const int y_surface = int(std::ceil(L.to_pixel({0.0, kSurface}).y()));
   const int y_bottom = int(std::floor(L.to_pixel({0.0, 0.0}).y()));
@@ -81,8 +82,8 @@ TEST(FrameRenderer, HydrostaticPressureColoursRiseMonotonicallyWithDepth) {
     ASSERT_GE(idx, previous) << "colour index fell with depth at y = " << y;
     previous = idx;
     const double y_m = (L.bed_y1 - (y + 0.5)) / L.px_per_m;
-    const double cell_centre_m = (std::floor(y_m / kDx) + 0.5) * kDx;
-    const double expect = std::min(255.0, std::floor(256.0 * (kSurface - cell_centre_m) / kSurface));
+    const double depth_m = std::clamp(kSurface - y_m, 0.5 * kDx, kSurface - 0.5 * kDx);
+    const double expect = std::min(255.0, std::floor(256.0 * depth_m / kSurface));
     EXPECT_NEAR(idx, expect, 2.0) << "at depth " << kSurface - y_m << " m";
     ++checked;
   }
@@ -372,6 +373,7 @@ TEST(FrameRenderer, SmoothDisplayStaysInsideTheMaterialAndRemovesTheStaircase) {
   style.field = "pressure";
   style.width = 960, style.height = 540;
   style.range = {0.0, max_pressure(), false};
+  style.smooth = false;
   FrameRenderer flat_r(style);
   style.smooth = true;
   FrameRenderer smooth_r(style);
@@ -382,13 +384,23 @@ TEST(FrameRenderer, SmoothDisplayStaysInsideTheMaterialAndRemovesTheStaircase) {
   const double cell_px = L.px_per_m * 0.01;
   ASSERT_GT(cell_px, 8.0);
   const Colormap& cmap = load_colormap("viridis");
-  // the cell under a pixel centre; `margin`: whether it lies 1.5 px clear of the cell's edges
+  // the cell under a pixel centre; `clear`: whether the pixel lies more than half a cell and 1.5 px
+  // from every cell of the other kind (material / none): the smoothed surface may move by up to half
+  // a cell from the cells' outline, no more
   auto cell_of = [&](int x, int y, bool* clear) -> long {
     const double cx = (x + 0.5 - L.bed_x0) / cell_px, cy = (L.bed_y1 - y - 0.5) / cell_px;
     if (cx <= 0 || cy <= 0 || cx >= f.nx || cy >= f.ny) return -1;
-    const double m = 1.5 / cell_px;
-    *clear = cx - std::floor(cx) > m && std::ceil(cx) - cx > m && cy - std::floor(cy) > m && std::ceil(cy) - cy > m;
-    return long(stored.index(int(cx), int(cy)));
+    const long c = long(stored.index(int(cx), int(cy)));
+    const uint8_t kind = stored.active[size_t(c)];
+    double d = 1e9;  // in cells, to the nearest cell of the other kind
+    for (int j = int(cy) - 2; j <= int(cy) + 2; ++j)
+      for (int i = int(cx) - 2; i <= int(cx) + 2; ++i) {
+        if (i < 0 || j < 0 || i >= f.nx || j >= f.ny || stored.active[stored.index(i, j)] == kind) continue;
+        const double ex = std::max({i - cx, 0.0, cx - (i + 1)}), ey = std::max({j - cy, 0.0, cy - (j + 1)});
+        d = std::min(d, std::hypot(ex, ey));
+      }
+    *clear = d > 0.5 + 1.5 / cell_px;
+    return c;
   };
   // a cell whose 8 neighbours all hold material (away from the free surface)
   auto deep_inside = [&](long c) {
