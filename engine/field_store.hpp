@@ -35,8 +35,11 @@ namespace furrow {
 //    zone of a rate-independent model a point is elastic (rate 0) on some steps, and with
 //    per-cell averages 4.9% of the flowing cells of plate_intrusion read as zero-rate specks.
 //  - cell_average: only the points inside the cell, equal weights per unit mass (the mosaic).
-// Either way a cell is active only when it holds a point itself, so the free surface stays where
-// the material is (the kernel widens nothing into the air).
+// A cell is active when it holds a point itself, so the free surface stays where the material is
+// (the kernel widens nothing into the air); with the B-spline, an empty cell is also active when
+// the kernel finds more than 0.4 of a cell's volume around it: a hole inside the material (points
+// pulled apart behind a body's corner) that a cell above a flat surface (0.16) or a one-cell notch
+// in it (0.37) never reaches.
 enum class RasterTransfer { quadratic_bspline, cell_average };
 
 // The cell grid fields are rasterized on; cell (i, j) spans origin + [i, i+1) x [j, j+1) dx.
@@ -53,7 +56,8 @@ struct RasterSpec {
 //   velocity, pressure, strain_rate, plastic_strain, phi_d: sum(w m q) / sum(w m)
 //   packing_fraction: sum(w m) / sum(w rho_g V)  (the mass-weighted mean of phi = m / (rho_g V))
 //   density:          sum(w m) / sum(w V)        (bulk density)
-// A cell is active when its own particles carry mass; inactive cells hold 0. Only the requested
+// A cell is active as above (cell_average: when its own particles carry mass); inactive cells hold
+// 0. Only the requested
 // fields are computed. Throws std::invalid_argument for an unknown field name, for a requested
 // field whose particle array is null (asking for phi_d in an NDPM run is a caller bug, not
 // something to skip silently), for missing positions/mass/volume and for a bad spec.
