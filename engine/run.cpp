@@ -18,6 +18,7 @@
 
 #include "engine/analysis.hpp"
 #include "engine/field_store.hpp"
+#include "engine/point_store.hpp"
 #include "engine/scene_io.hpp"
 #include "engine/simulation.hpp"
 
@@ -35,7 +36,10 @@ nlohmann::json result_defining_json(const Scene& scene) {
   Scene s = scene;
   s.solver.threads = 0;
   s.outputs.movies.clear();  // drawn from the stored frames after the run; a sweep skips them
-  return scene_to_json(s);
+  nlohmann::json j = scene_to_json(s);
+  // the key's absence reads as false: scenes without points keep the hash they had before it
+  if (!s.outputs.points) j["outputs"].erase("points");
+  return j;
 }
 
 bool process_running(long pid) { return pid > 0 && (::kill(pid_t(pid), 0) == 0 || errno == EPERM); }
@@ -291,7 +295,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   int64_t frame_index = 0;
   double next_frame_s = 0.0;
   auto write_frame = [&] {
-    FieldFrame f = rasterize(sim.particle_view(), raster, fields);
+    const ParticleView view = sim.particle_view();
+    FieldFrame f = rasterize(view, raster, fields);
     f.scene_name = scene.name;
     f.step = sim.step_count();
     f.time_s = sim.time_s();
@@ -299,6 +304,17 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     f.bodies = sim.body_outlines();
     if (analysis.wants_frames())
       analysis.add_frame(f, sim.lead_body_travel_m(), sim.bodies()[size_t(analysis.lead_index())].velocity_m_s);
+    if (out.points) {
+      // before the frame file: once frame k exists, so do its points
+      PointFrameInfo info;
+      info.scene_name = f.scene_name;
+      info.step = f.step;
+      info.time_s = f.time_s;
+      info.dt_s = f.dt_s;
+      info.dx_m = raster.dx_m;
+      info.bodies = f.bodies;
+      write_points_vdb(points_path(tmp_dir.string(), frame_index), info, view);
+    }
     write_frame_vdb(frame_path(tmp_dir.string(), frame_index), f);
     if (opt.frame_written) opt.frame_written(frame_index, frame_path(tmp_dir.string(), frame_index));
     if (opt.write_paraview) {

@@ -1,5 +1,6 @@
 // A run: drives a Simulation over a scene and writes its outputs into a run directory
-//   scene.json (as run), forces.csv, frames/frame_NNNNN.vdb (+ .vti and frames.pvd), run.json
+//   scene.json (as run), forces.csv, frames/frame_NNNNN.vdb (+ .vti and frames.pvd, and
+//   points_NNNNN.vdb with outputs.points), run.json
 // The directory is built under a temporary name beside the target and renamed into place when the
 // run completes, so a previous run is never overwritten silently and readers never see half a run.
 #pragma once
@@ -68,7 +69,8 @@ RunSummary run_scene(const Scene& scene, const RunOptions& options);
 
 // The resolved scene without what cannot change a run's results (solver.threads: runs are
 // bit-identical for any thread count; outputs.movies: rendered from the frames afterwards): two
-// runs are of the same scene when these are equal.
+// runs are of the same scene when these are equal. outputs.points is left out when false, so
+// scenes from before the key keep their hash.
 nlohmann::json result_defining_json(const Scene& scene);
 // FNV-1a 64 of result_defining_json(scene).dump() as 16 hex digits; run.json's "scene_hash", so a
 // finished run directory says which scene it completed without reparsing its scene.json.

@@ -107,6 +107,7 @@ struct Outputs {
   double frame_interval_s = 0.0;   // 0: no frames
   std::vector<std::string> fields; // e.g. "pressure", "strain_rate", "packing_fraction", "velocity"
   std::vector<std::string> movies; // subset of fields rendered to movies/<field>.mp4
+  bool points = false;             // also store the material points with each frame (points_NNNNN.vdb)
   double force_interval_s = 0.0;   // 0: one forces.csv row per body per step
   // summary window for mean forces: by time, or by body displacement when set (> 0)
   double average_from_s = 0.0, average_to_s = -1.0;

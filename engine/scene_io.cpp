@@ -517,6 +517,12 @@ Outputs read_outputs(const Ctx& c, const json* j, const Scene& s) {
   if (!out.fields.empty() && out.frame_interval_s == 0.0)
     fail(c, o.at("frame_interval_s"), o.opt("frame_interval_s") ? short_dump(*o.opt("frame_interval_s")) : "(missing)",
          "a number > 0 (s) when /outputs/fields lists fields");
+  out.points = boolean(o, "points", false);
+  // points are written with each stored frame; fields listed imply frame_interval_s > 0 (above)
+  if (out.points && out.fields.empty())
+    fail(c, o.at("points"), *o.opt("points"),
+         "false when no frames are stored (points go with each frame: list /outputs/fields and set "
+         "/outputs/frame_interval_s > 0)");
   out.force_interval_s = num(o, "force_interval_s", kNonNegative, "s", 0.0, ", 0 for every step");
   if (const json* w = o.opt("average_window")) {
     Obj a(c, *w, o.at("average_window"), kWindowKeys);

@@ -118,7 +118,7 @@ const KeyList kFrictionWallKeys = {"type", "friction"};
 const KeyList kPlainWallKeys = {"type"};
 const KeyList kEffectsKeys = {"gravity", "gravity_m_s2", "dilatancy", "separation", "body_friction",
                               "wall_friction", "rate_dependence"};
-const KeyList kOutputsKeys = {"frame_interval_s", "fields", "movies", "force_interval_s",
+const KeyList kOutputsKeys = {"frame_interval_s", "fields", "movies", "points", "force_interval_s",
                               "average_window"};
 const KeyList kWindowKeys = {"from_s", "to_s", "from_m", "to_m"};
 

@@ -147,6 +147,7 @@ J to_json(const Scene& s) {
   out["frame_interval_s"] = s.outputs.frame_interval_s;
   out["fields"] = s.outputs.fields;
   out["movies"] = s.outputs.movies;
+  out["points"] = s.outputs.points;
   out["force_interval_s"] = s.outputs.force_interval_s;
   J window = J::object();
   if (s.outputs.average_from_m >= 0.0) {

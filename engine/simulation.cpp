@@ -215,8 +215,9 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     std::tie(s.lo_m, s.hi_m) = shape_bounds_m(b.shape);
     bodies_.push_back(s);
   }
-  // plastic strain and its rate are kept only when a stored field needs them
+  // plastic strain and its rate are kept only when a stored field or the stored points need them
   for (const auto& f : scene_.outputs.fields) track_plastic_ |= f == "strain_rate" || f == "plastic_strain";
+  track_plastic_ |= scene_.outputs.points;
   seed_beds();
   if (scene_.solver.contact == ContactMethod::CellFraction) sample_body_fields();
 

@@ -1,27 +1,23 @@
 // OpenVDB frame files: write_frame_vdb / read_frame (layout documented in field_store.hpp).
 #include "engine/field_store.hpp"
 
-#include <nlohmann/json.hpp>
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
+
+#include "engine/vdb_meta.hpp"
 
 namespace furrow {
 
 namespace {
 
+using vdb_detail::init_openvdb;
+
 constexpr const char* kPackingAlias = "density";  // Blender shows a grid of this name unasked
 constexpr const char* kCopyOfKey = "copy_of";
-
-void init_openvdb() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 
 void check_frame(const FieldFrame& f) {
   auto bad = [](const std::string& what) {
@@ -39,34 +35,6 @@ void check_frame(const FieldFrame& f) {
   if (f.velocity_x.size() != f.velocity_y.size() || (!f.velocity_x.empty() && f.velocity_x.size() != n))
     bad("velocity components must both have nx*ny cells");
   if (f.scalars.empty() && f.velocity_x.empty()) bad("frame has no fields to store");
-}
-
-nlohmann::json bodies_to_json(const std::vector<BodyOutline>& bodies) {
-  auto vec = [](const Eigen::Vector2d& v) { return nlohmann::json::array({v.x(), v.y()}); };
-  nlohmann::json out = nlohmann::json::array();
-  for (const auto& b : bodies) {
-    nlohmann::json outline = nlohmann::json::array();
-    for (const auto& v : b.outline_m) outline.push_back(vec(v));
-    out.push_back({{"name", b.name},
-                   {"position_m", vec(b.position_m)},
-                   {"force_N_per_m", vec(b.force_N_per_m)},
-                   {"outline_m", outline}});
-  }
-  return out;
-}
-
-std::vector<BodyOutline> bodies_from_json(const nlohmann::json& j) {
-  auto vec = [](const nlohmann::json& a) { return Eigen::Vector2d(a.at(0).get<double>(), a.at(1).get<double>()); };
-  std::vector<BodyOutline> bodies;
-  for (const auto& jb : j) {
-    BodyOutline b;
-    b.name = jb.at("name").get<std::string>();
-    b.position_m = vec(jb.at("position_m"));
-    b.force_N_per_m = vec(jb.at("force_N_per_m"));
-    for (const auto& v : jb.at("outline_m")) b.outline_m.push_back(vec(v));
-    bodies.push_back(std::move(b));
-  }
-  return bodies;
 }
 
 // A grid holding value_at(c) in each active cell c = index(i, j) at voxel (i, j, 0).
@@ -127,19 +95,12 @@ void write_frame_vdb(const std::string& path, const FieldFrame& f) {
     grids.push_back(alias);
   }
 
-  openvdb::MetaMap meta;
-  meta.insertMeta("scene", openvdb::StringMetadata(f.scene_name));
-  meta.insertMeta("time_s", openvdb::DoubleMetadata(f.time_s));
-  meta.insertMeta("step", openvdb::Int64Metadata(f.step));
-  meta.insertMeta("dt_s", openvdb::DoubleMetadata(f.dt_s));
-  meta.insertMeta("dx_m", openvdb::DoubleMetadata(f.dx_m));
+  openvdb::MetaMap meta;  // a sorted map: the order of insertion does not reach the file
+  vdb_detail::put_frame_meta(meta, f.scene_name, f.time_s, f.step, f.dt_s, f.dx_m, f.bodies);
   meta.insertMeta("nx", openvdb::Int32Metadata(f.nx));
   meta.insertMeta("ny", openvdb::Int32Metadata(f.ny));
   meta.insertMeta("origin_x_m", openvdb::DoubleMetadata(f.origin_m.x()));
   meta.insertMeta("origin_y_m", openvdb::DoubleMetadata(f.origin_m.y()));
-  meta.insertMeta("dimension", openvdb::Int32Metadata(2));
-  meta.insertMeta("furrow_version", openvdb::StringMetadata(FURROW_VERSION));
-  meta.insertMeta("bodies_json", openvdb::StringMetadata(bodies_to_json(f.bodies).dump()));
 
   write_atomically(path, [&](const std::string& tmp) {
     openvdb::io::File file(tmp);
@@ -154,11 +115,7 @@ namespace {
 
 template <class T>
 T file_meta(const openvdb::MetaMap& meta, const std::string& key, const std::string& path) {
-  auto m = meta.getMetadata<openvdb::TypedMetadata<T>>(key);
-  if (!m)
-    throw std::runtime_error("read_frame: " + path + ": metadata '" + key +
-                             "' is missing or has the wrong type (not a Furrow frame?)");
-  return m->value();
+  return vdb_detail::file_meta<T>(meta, key, path, "read_frame", "frame");
 }
 
 // Marks the grid's active voxels in f.active and hands each (cell, value) to `store`.
@@ -181,21 +138,9 @@ void read_grid(const GridT& grid, FieldFrame& f, const std::string& path, Store 
 }  // namespace
 
 FieldFrame read_frame(const std::string& vdb_path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(vdb_path, ec))
-    throw std::runtime_error("read_frame: no such file " + vdb_path);
-  init_openvdb();
-  openvdb::MetaMap::Ptr meta;
-  openvdb::GridPtrVecPtr grids;
-  try {
-    openvdb::io::File file(vdb_path);
-    file.open(false);  // read everything now: the file may be replaced while we hold the frame
-    meta = file.getMetadata();
-    grids = file.getGrids();
-    file.close();
-  } catch (const std::exception& e) {
-    throw std::runtime_error("read_frame: " + vdb_path + ": not a readable OpenVDB file (" + e.what() + ")");
-  }
+  const vdb_detail::VdbContents contents = vdb_detail::read_vdb(vdb_path, "read_frame");
+  const openvdb::MetaMap::Ptr& meta = contents.meta;
+  const openvdb::GridPtrVecPtr& grids = contents.grids;
 
   FieldFrame f;
   f.scene_name = file_meta<std::string>(*meta, "scene", vdb_path);
@@ -208,11 +153,7 @@ FieldFrame read_frame(const std::string& vdb_path) {
   f.origin_m = {file_meta<double>(*meta, "origin_x_m", vdb_path), file_meta<double>(*meta, "origin_y_m", vdb_path)};
   if (f.nx <= 0 || f.ny <= 0 || !(f.dx_m > 0.0))
     throw std::runtime_error("read_frame: " + vdb_path + ": metadata nx, ny, dx_m must be positive");
-  try {
-    f.bodies = bodies_from_json(nlohmann::json::parse(file_meta<std::string>(*meta, "bodies_json", vdb_path)));
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error("read_frame: " + vdb_path + ": metadata 'bodies_json' is malformed: " + e.what());
-  }
+  f.bodies = vdb_detail::bodies_meta(*meta, vdb_path, "read_frame", "frame");
 
   const size_t n = size_t(f.nx) * size_t(f.ny);
   f.active.assign(n, 0);
