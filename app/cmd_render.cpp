@@ -14,6 +14,7 @@
 #include "render/force_series.hpp"
 #include "render/image_io.hpp"
 #include "render/layouts.hpp"
+#include "render/point_splat.hpp"
 #include "render/plot.hpp"
 #include "render/test_scene.hpp"
 
@@ -235,6 +236,19 @@ int render_main(const Parsed& p) {
         return 1;
       }
     }
+  const std::vector<std::vector<std::string>> grid_frames = run_frames;
+  if (p.has("--points")) {
+    if (sheet) throw UsageError("--points draws movies and --png, not contact sheets");
+    style.smooth = false;  // the discs, not a blend of them
+    for (size_t r = 0; r < runs.size(); ++r) {  // the frame files stay the grid and the checks' source
+      for (auto& f : run_frames[r]) f = render::points_path_for(f);
+      if (!fs::exists(run_frames[r].front())) {
+        std::cerr << "furrow render: --points: " << run_frames[r].front()
+                  << " does not exist (run the scene with outputs.points true to store the points)\n";
+        return 1;
+      }
+    }
+  }
   const double fps = p.has("--fps") ? parse_number(p.get("--fps"), "--fps") : render::movie_fps(frames.size());
   if (!(fps > 0)) throw UsageError("--fps must be > 0");
 
@@ -272,9 +286,9 @@ int render_main(const Parsed& p) {
   auto panel_of = [&](size_t r) {
     const render::ForcePanel raw = render::read_force_panel((fs::path(runs[r]) / "forces.csv").string());
     if (p.has("--raw-force")) return raw;
-    const double dx_mm = 1000.0 * read_frame(run_frames[r].front()).dx_m;
+    const double dx_mm = 1000.0 * read_frame(grid_frames[r].front()).dx_m;
     char text[64];
-    std::snprintf(text, sizeof text, "%.3g mm = 1 cell", dx_mm);
+    std::snprintf(text, sizeof text, "1 cell = %.3g mm", dx_mm);
     return render::with_running_mean(raw, dx_mm, text);
   };
   const fs::path forces = fs::path(runs.front()) / "forces.csv";
@@ -447,6 +461,9 @@ Command command_render() {
           "                   across its travel), time as t v/L; v and L come from RUN_DIR/scene.json and\n"
           "                   are printed in the title\n"
           "\n"
+          "--points draws the material points of frames/points_NNNNN.vdb (scenes with outputs.points)\n"
+          "as discs of their own area coloured by their own value, as the paper's figures do.\n"
+          "\n"
           "Outputs (default: a movie):\n"
           "  movie            RUN_DIR/movies/<field>.mp4 (H.264, yuv420p, faststart: plays in browsers;\n"
           "                   even sizes; ~10 s long unless --fps), its last frame as <field>.png beside it\n"
@@ -476,6 +493,7 @@ Command command_render() {
            {"--normalize", false, false, "dimensionless velocity (/v), strain rate (/(v/L)) and time (t v/L)"},
            {"--no-panel", false, false, "leave out the force panel"},
            {"--raw-force", false, false, "force panel: every step only (default: one cell's running mean over it)"},
+           {"--points", false, false, "draw the stored material points (outputs.points) as discs coloured by their own value"},
            {"--cells", false, false, "draw each cell as one flat colour (default: blended within the material)"},
            {"--smooth", false, false, "blend values within the material: the default, kept for old scripts"}},
           1,

@@ -17,7 +17,7 @@ void render_run_movies(const std::string& run_dir, const Scene& scene, bool quie
   const auto paths = list_frames(run_dir);
   if (paths.empty()) return;
   char window[64];
-  std::snprintf(window, sizeof window, "%.3g mm = 1 cell", 1000.0 * scene.domain.dx_m);
+  std::snprintf(window, sizeof window, "1 cell = %.3g mm", 1000.0 * scene.domain.dx_m);
   const render::ForcePanel panel = render::with_running_mean(
       render::read_force_panel((fs::path(run_dir) / "forces.csv").string()), 1000.0 * scene.domain.dx_m, window);
   fs::create_directories(fs::path(run_dir) / "movies");

@@ -7,7 +7,9 @@
 #include <stdexcept>
 
 #include "engine/field_store.hpp"
+#include "engine/point_store.hpp"
 #include "render/movie_writer.hpp"
+#include "render/point_splat.hpp"
 
 namespace fs = std::filesystem;
 
@@ -32,8 +34,21 @@ std::vector<float> checked_values(const FieldFrame& f, const std::string& field,
   }
 }
 
-// A stored frame with every field the image needs (else an error naming the file).
+// A stored frame with every field the image needs (else an error naming the file). A points file
+// (points_NNNNN.vdb) is drawn as discs over its frame file's grid, 4 texels per cell.
 FieldFrame read_with_fields(const std::string& path, const std::vector<std::string>& fields) {
+  if (fs::path(path).filename().string().rfind("points_", 0) == 0) {
+    const std::string name = fs::path(path).filename().string();
+    const FieldFrame grid = read_checked((fs::path(path).parent_path() / ("frame_" + name.substr(7))).string());
+    PointFrame points;
+    try {
+      points = read_points(path);
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      throw std::runtime_error(what.find(path) == std::string::npos ? path + ": " + what : what);
+    }
+    return splat_points(points, grid, 4, fields, path);
+  }
   FieldFrame f = read_checked(path);
   for (const auto& field : fields) checked_values(f, field, path);
   return f;

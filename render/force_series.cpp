@@ -122,7 +122,7 @@ ForcePanel with_running_mean(const ForcePanel& panel, double window, const std::
     out.series.push_back(faint);
     out.series.push_back(mean);
   }
-  out.title = panel.title + "\n(line: mean over " + window_text + " of travel; faint: every step)";
+  out.title = panel.title + "\n(line: mean over " + window_text + "; faint: raw)";
   return out;
 }
 

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/point_store.hpp"
 #include "engine/scene_io.hpp"
+#include "render/colormap.hpp"
 #include "render/image_io.hpp"
 #include "tests/app/cli_fixture.hpp"
 #include "tests/app/stored_run.hpp"
@@ -155,4 +157,41 @@ TEST_F(RenderLayouts, MovieHasAPosterAndAFrameRateForItsLength) {
   EXPECT_EQ(again.status, 1);
 }
 
+}  // namespace
+
+namespace {
+// The material points drawn as discs: a run whose frames have points files beside them renders
+// with --points; one without says which file is missing and writes nothing.
+TEST_F(RenderLayouts, PointsRenderAsDiscsAndTheirAbsenceIsAnError) {
+  const StoredRun stored(dir_);
+  const auto missing = run({"render", dir_.string(), "--field", "pressure", "--points", "--png", "--out", path("p0")});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("points_00000.vdb"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(path("p0")));
+  for (int k = 0; k < StoredRun::kFrames; ++k) {
+    furrow::PointFrame pts;
+    pts.dx_m = StoredRun::kDx;
+    pts.time_s = 0.01 * k;
+    for (int j = 0; j < 80; ++j)
+      for (int i = 0; i < 160; ++i) {
+        pts.x_m.push_back((i + 0.5) * 0.0025), pts.y_m.push_back((j + 0.5) * 0.0025);
+        pts.vx_m_s.push_back(0.f), pts.vy_m_s.push_back(0.f), pts.volume_m2.push_back(float(0.0025 * 0.0025));
+        pts.pressure_Pa.push_back(float(1000.0 * (0.2 - pts.y_m.back())));
+      }
+    furrow::write_points_vdb(furrow::points_path(dir_.string(), k), pts);
+  }
+  const auto r = run({"render", dir_.string(), "--field", "pressure", "--points", "--png", "--frames", "1",
+                      "--no-panel", "--size", "640x360", "--out", path("p1")});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const RgbImage img = furrow::render::read_png(path("p1") + "/points_00001.png");
+  const auto& viridis = furrow::render::load_colormap("viridis");
+  int coloured = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      double d = 0;
+      viridis.nearest_index(img.at(x, y), &d);
+      coloured += d < 2.0;
+    }
+  EXPECT_GT(coloured, 30000);  // the bed of points, ~0.4 x 0.2 m at ~1000 px/m
+}
 }  // namespace

@@ -8,6 +8,7 @@
 #include "render/force_series.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/layouts.hpp"
+#include "render/point_splat.hpp"
 #include "tests/render/synthetic_frames.hpp"
 
 using namespace furrow;
@@ -68,7 +69,7 @@ TEST(Layouts, ForcePanelDrawsTheOneCellMeanOverTheFaintRawTrace) {
     s.y.push_back(k % 40 == 0 ? 113.0 : 100.0);
   }
   panel.series.push_back(s);
-  const ForcePanel m = with_running_mean(panel, 5.0, "5 mm = 1 cell");
+  const ForcePanel m = with_running_mean(panel, 5.0, "1 cell = 5 mm");
   ASSERT_EQ(m.series.size(), 2u);
   EXPECT_TRUE(m.series[0].faint);
   EXPECT_FALSE(m.series[1].faint);
@@ -77,9 +78,39 @@ TEST(Layouts, ForcePanelDrawsTheOneCellMeanOverTheFaintRawTrace) {
   double worst = 0;
   for (size_t k = 50; k + 50 < s.y.size(); ++k) worst = std::max(worst, std::abs(m.series[1].y[k] / mean - 1.0));
   EXPECT_LT(worst, 0.01);
-  EXPECT_NE(m.title.find("mean over 5 mm = 1 cell"), std::string::npos) << m.title;
+  EXPECT_NE(m.title.find("mean over 1 cell = 5 mm"), std::string::npos) << m.title;
   // against time (no body moves) nothing is averaged
   ForcePanel by_time = panel;
   by_time.x_label = "time (s)";
   EXPECT_EQ(with_running_mean(by_time, 5.0, "").series.size(), 1u);
+}
+
+// Points drawn as discs: each disc covers about its point's area (pi r^2 = V), carries its point's
+// own value, and nothing lies between discs that are apart.
+TEST(Layouts, PointsAreDiscsOfTheirOwnAreaAndValue) {
+  FieldFrame grid;
+  grid.nx = 20, grid.ny = 10, grid.dx_m = 0.01;
+  PointFrame pts;
+  pts.dx_m = 0.01;
+  pts.time_s = 0.5;
+  for (int k = 0; k < 5; ++k) {
+    pts.x_m.push_back(0.02 + 0.035 * k), pts.y_m.push_back(0.05);
+    pts.vx_m_s.push_back(0.f), pts.vy_m_s.push_back(-0.1f * k);
+    pts.volume_m2.push_back(float(M_PI * 0.004 * 0.004));  // discs of radius 4 mm
+    pts.pressure_Pa.push_back(100.f * float(k + 1));
+  }
+  const int sub = 8;  // 1.25 mm texels
+  const FieldFrame f = splat_points(pts, grid, sub, {"pressure", "velocity_y"}, "test");
+  EXPECT_EQ(f.nx, 160);
+  EXPECT_DOUBLE_EQ(f.time_s, 0.5);
+  const double texel_area = 0.00125 * 0.00125, disc_area = M_PI * 0.004 * 0.004;
+  for (int k = 0; k < 5; ++k) {
+    int covered = 0;
+    for (size_t c = 0; c < f.active.size(); ++c)
+      if (f.active[c] && f.scalars.at("pressure")[c] == 100.f * float(k + 1)) ++covered;
+    EXPECT_NEAR(covered * texel_area, disc_area, 0.25 * disc_area) << k;
+  }
+  EXPECT_EQ(f.velocity_y[f.index(int(0.09 / 0.00125), int(0.05 / 0.00125))], -0.2f);  // point 2's own value
+  EXPECT_EQ(f.active[f.index(int(0.0375 / 0.00125), int(0.05 / 0.00125))], 0);  // between points 0 and 1
+  EXPECT_THROW(splat_points(pts, grid, sub, {"strain_rate"}, "test"), std::runtime_error);  // not stored
 }
