@@ -131,11 +131,29 @@ int render_main(const Parsed& p) {
       std::cerr << "furrow render: run directory '" << run_dir << "' does not exist\n";
       return 1;
     }
-  if (!p.has("--field")) throw UsageError("--field NAME[,NAME...] is required (fields: " + all_fields() + ")");
-  const std::vector<std::string> fields = split(p.get("--field"), ',');
+  // --layout: the fields, frame and scales the first run's scene names (outputs.layout); options
+  // given as well take precedence
+  MovieLayout layout;
+  if (p.has("--layout")) {
+    const fs::path scene_path = fs::path(runs.front()) / "scene.json";
+    if (!fs::exists(scene_path))
+      throw std::runtime_error("--layout: " + scene_path.string() + " does not exist (it names the layout)");
+    layout = load_scene(scene_path.string()).outputs.layout;
+    if (layout.name.empty())
+      throw std::runtime_error("--layout: " + scene_path.string() +
+                               " names no outputs.layout (give --field, --frame-of, --normalize instead)");
+  }
+  std::string field_list = p.get("--field");
+  if (field_list.empty())
+    for (const auto& f : layout.fields) field_list += (field_list.empty() ? "" : ",") + f;
+  if (field_list.empty())
+    throw UsageError("--field NAME[,NAME...] is required (fields: " + all_fields() + ")");
+  const std::string frame_of = p.get("--frame-of", layout.frame_of);
+  const bool normalize = p.has("--normalize") || layout.normalize;
+  const std::vector<std::string> fields = split(field_list, ',');
   for (size_t k = 0; k < fields.size(); ++k) {
     if (!render::find_display_field(fields[k])) {
-      std::cerr << "furrow render: unknown field '" << fields[k] << "' in --field " << p.get("--field")
+      std::cerr << "furrow render: unknown field '" << fields[k] << "' in --field " << field_list
                 << " (valid fields: " << all_fields() << ")\n";
       return 2;
     }
@@ -144,14 +162,14 @@ int render_main(const Parsed& p) {
   }
   const bool several_runs = runs.size() > 1;
   if (several_runs && fields.size() > 1)
-    throw UsageError("several runs side by side take one --field (got " + p.get("--field") + ")");
+    throw UsageError("several runs side by side take one --field (got " + field_list + ")");
   const bool several = fields.size() > 1 || several_runs;
   if (fields.size() > 1 && (p.has("--range") || p.has("--colormap")))
     throw UsageError("--range and --colormap apply to a single --field");
   if (p.has("--png") && p.has("--contact-sheet")) throw UsageError("--png and --contact-sheet exclude each other");
   const bool sheet = p.has("--contact-sheet");
   if (sheet && several_runs) throw UsageError("--contact-sheet takes one run");
-  if (sheet && (p.has("--frame-of") || p.has("--normalize")))
+  if (sheet && (!frame_of.empty() || normalize))
     throw UsageError("--frame-of and --normalize apply to movies and --png");
   std::vector<std::string> labels;
   if (p.has("--labels")) {
@@ -160,14 +178,14 @@ int render_main(const Parsed& p) {
       throw UsageError("--labels: " + std::to_string(labels.size()) + " labels for " + std::to_string(runs.size()) +
                        " runs");
   }
-  const double zoom = p.has("--zoom") ? parse_number(p.get("--zoom"), "--zoom") : 1.0;
+  const double zoom = p.has("--zoom") ? parse_number(p.get("--zoom"), "--zoom") : layout.zoom;
   if (!(zoom >= 1.0 && zoom <= 50.0)) throw UsageError("--zoom must be in 1..50, got " + p.get("--zoom"));
-  if (p.has("--zoom") && !p.has("--frame-of")) throw UsageError("--zoom goes with --frame-of BODY");
+  if (zoom != 1.0 && frame_of.empty()) throw UsageError("--zoom goes with --frame-of BODY");
 
   render::FrameStyle style;
   style.field = fields.front();
   style.smooth = !p.has("--cells");
-  style.follow_body = p.get("--frame-of");
+  style.follow_body = frame_of;
   style.zoom = zoom;
   if (p.has("--colormap")) {
     style.colormap = p.get("--colormap");
@@ -271,7 +289,7 @@ int render_main(const Parsed& p) {
     if (p.has("--range")) apply_range_option(p.get("--range"), s.field, &s.range);
     if (several_runs) s.title = labels.empty() ? fs::path(runs[k]).filename().string() : labels[k];
     if (k == 0 || !several_runs) ranges += (ranges.empty() ? "" : "; ") + range_text(s.field, s.range);
-    if (p.has("--normalize")) {
+    if (normalize) {
       const fs::path scene_path = fs::path(runs[several_runs ? k : 0]) / "scene.json";
       if (!fs::exists(scene_path))
         throw std::runtime_error("--normalize: " + scene_path.string() + " does not exist (it names the body's speed and size)");
@@ -316,8 +334,10 @@ int render_main(const Parsed& p) {
   if (p.has("--size")) parse_size(p.get("--size"), &style.width, &style.height);
   panels_style.width = style.width, panels_style.height = style.height;
 
-  std::string name;  // default output name: the fields (several runs: and the labels) joined by '-'
-  for (const auto& f : fields) name += (name.empty() ? "" : "-") + f;
+  // default output name: the layout's, else the fields (several runs: and the labels) joined by '-'
+  std::string name = layout.name;
+  if (name.empty())
+    for (const auto& f : fields) name += (name.empty() ? "" : "-") + f;
   if (several_runs)
     for (const auto& s : panels_style.fields) name += "-" + s.title;
   bool overwrite = false;
@@ -461,6 +481,8 @@ Command command_render() {
           "                   across its travel), time as t v/L; v and L come from RUN_DIR/scene.json and\n"
           "                   are printed in the title\n"
           "\n"
+          "--layout takes all of that from RUN_DIR/scene.json's outputs.layout (each paper template\n"
+          "names its movie's layout), writing movies/<layout name>.mp4.\n"
           "--points draws the material points of frames/points_NNNNN.vdb (scenes with outputs.points)\n"
           "as discs of their own area coloured by their own value, as the paper's figures do.\n"
           "\n"
@@ -493,6 +515,7 @@ Command command_render() {
            {"--normalize", false, false, "dimensionless velocity (/v), strain rate (/(v/L)) and time (t v/L)"},
            {"--no-panel", false, false, "leave out the force panel"},
            {"--raw-force", false, false, "force panel: every step only (default: one cell's running mean over it)"},
+           {"--layout", false, false, "the paper's layout the run's scene names (outputs.layout): fields, frame, scales"},
            {"--points", false, false, "draw the stored material points (outputs.points) as discs coloured by their own value"},
            {"--cells", false, false, "draw each cell as one flat colour (default: blended within the material)"},
            {"--smooth", false, false, "blend values within the material: the default, kept for old scripts"}},

@@ -3,7 +3,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <stdexcept>
 
+#include "app/commands.hpp"
 #include "engine/field_store.hpp"
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"
@@ -13,7 +15,7 @@ namespace fs = std::filesystem;
 namespace furrow::cli {
 
 void render_run_movies(const std::string& run_dir, const Scene& scene, bool quiet) {
-  if (scene.outputs.movies.empty()) return;
+  if (scene.outputs.movies.empty() && scene.outputs.layout.name.empty()) return;
   const auto paths = list_frames(run_dir);
   if (paths.empty()) return;
   char window[64];
@@ -31,6 +33,16 @@ void render_run_movies(const std::string& run_dir, const Scene& scene, bool quie
     const std::string out = (fs::path(run_dir) / "movies" / (field + ".mp4")).string();
     render::render_movie(paths, style, out, render::movie_fps(paths.size()), false);
     if (!quiet) std::cerr << "movie: " << out << " (" << paths.size() << " frames)\n";
+  }
+  if (!scene.outputs.layout.name.empty()) {
+    // the paper's layout of this case: the same path as `furrow render RUN_DIR --layout`
+    static const Command render = command_render();
+    Parsed layout;
+    layout.command = &render;
+    layout.positional = {run_dir};
+    layout.values["--layout"] = {};
+    layout.values["--out"] = {(fs::path(run_dir) / "movies" / (scene.outputs.layout.name + ".mp4")).string()};
+    if (render.main(layout) != 0) throw std::runtime_error(run_dir + ": the layout movie failed (above)");
   }
 }
 

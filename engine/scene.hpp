@@ -103,11 +103,23 @@ struct Effects {
   bool wall_friction = true;
 };
 
+// A movie layout, as the paper's supplementary movies show a case: several fields side by side,
+// optionally in a body's frame of reference and dimensionless. `furrow run` renders it to
+// movies/<name>.mp4; `furrow render RUN --layout` renders it again (of several runs too).
+struct MovieLayout {
+  std::string name;                 // movies/<name>.mp4; "" when the scene has no layout
+  std::vector<std::string> fields;  // stored fields, or the velocity's components velocity_x / velocity_y
+  std::string frame_of;             // a body's name: the body stays still in the image; "" for none
+  double zoom = 1.0;                // with frame_of: the view enlarged about the body
+  bool normalize = false;           // velocity / v, strain rate / (v/L), time t v/L (first moving body)
+};
+
 struct Outputs {
   double frame_interval_s = 0.0;   // 0: no frames
   std::vector<std::string> fields; // e.g. "pressure", "strain_rate", "packing_fraction", "velocity"
   std::vector<std::string> movies; // subset of fields rendered to movies/<field>.mp4
   bool points = false;             // also store the material points with each frame (points_NNNNN.vdb)
+  MovieLayout layout;              // the paper's layout of this case's movie (none when name is "")
   double force_interval_s = 0.0;   // 0: one forces.csv row per body per step
   // summary window for mean forces: by time, or by body displacement when set (> 0)
   double average_from_s = 0.0, average_to_s = -1.0;

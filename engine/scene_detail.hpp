@@ -32,7 +32,7 @@ std::string suggestion(const std::string& got, const KeyList& candidates);
 std::string one_of(const KeyList& names);  // "\"a\"" or "one of \"a\", \"b\""
 
 // ---- schema: the keys of every object, in README order ----
-extern const KeyList kRootKeys, kDomainKeys, kSolverKeys, kMaterialNdpmKeys, kMaterialDpmKeys, kBedKeys, kBodyKeys, kBoxKeys, kCircleKeys, kPolygonKeys, kUnionKeys, kConstantMotionKeys, kPathMotionKeys, kKnotKeys, kWallsKeys, kFrontBackKeys, kFrictionWallKeys, kPlainWallKeys, kEffectsKeys, kOutputsKeys, kWindowKeys, kModels, kShapeTypes, kMotionTypes, kWallTypes, kShapeFunctions, kContactMethods;
+extern const KeyList kRootKeys, kDomainKeys, kSolverKeys, kMaterialNdpmKeys, kMaterialDpmKeys, kBedKeys, kBodyKeys, kBoxKeys, kCircleKeys, kPolygonKeys, kUnionKeys, kConstantMotionKeys, kPathMotionKeys, kKnotKeys, kWallsKeys, kFrontBackKeys, kFrictionWallKeys, kPlainWallKeys, kEffectsKeys, kOutputsKeys, kLayoutKeys, kWindowKeys, kModels, kShapeTypes, kMotionTypes, kWallTypes, kShapeFunctions, kContactMethods;
 // Keys of a variant object (shape/motion/wall "type", material "model") for the variant `obj`
 // names; every variant's keys when it names none.
 KeyList shape_keys(const json* obj, bool is_part);

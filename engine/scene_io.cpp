@@ -523,6 +523,41 @@ Outputs read_outputs(const Ctx& c, const json* j, const Scene& s) {
     fail(c, o.at("points"), *o.opt("points"),
          "false when no frames are stored (points go with each frame: list /outputs/fields and set "
          "/outputs/frame_interval_s > 0)");
+  if (const json* l = o.opt("layout")) {
+    Obj a(c, *l, o.at("layout"), kLayoutKeys);
+    MovieLayout& lay = out.layout;
+    lay.name = name_value(a, "name");
+    const json& lf = array(a, "fields", "field names", true, 1);
+    KeyList drawable = out.fields;  // what the layout can draw: the stored fields, and velocity's components
+    if (std::find(out.fields.begin(), out.fields.end(), "velocity") != out.fields.end())
+      drawable.insert(drawable.end(), {"velocity_x", "velocity_y"});
+    const std::string expected = "a field stored in /outputs/fields, or velocity_x / velocity_y when velocity is" +
+                                 (drawable.empty() ? std::string(" (none is stored)") : ": " + one_of(drawable));
+    for (size_t i = 0; i < lf.size(); ++i) {
+      const std::string p = a.at("fields") + "/" + std::to_string(i);
+      const std::string f = as_string(c, lf[i], p, expected);
+      if (std::find(drawable.begin(), drawable.end(), f) == drawable.end())
+        fail(c, p, lf[i], expected + suggestion(f, drawable));
+      if (std::find(lay.fields.begin(), lay.fields.end(), f) != lay.fields.end())
+        fail(c, p, lf[i], "each field listed once");
+      lay.fields.push_back(f);
+    }
+    if (const json* b = a.opt("frame_of"); b && !b->is_null()) {
+      KeyList bodies;
+      for (const auto& body : s.bodies) bodies.push_back(body.name);
+      const std::string want = "the name of a body in /bodies" + (bodies.empty() ? std::string(" (there is none)") : ": " + one_of(bodies));
+      lay.frame_of = as_string(c, *b, a.at("frame_of"), want);
+      if (std::find(bodies.begin(), bodies.end(), lay.frame_of) == bodies.end())
+        fail(c, a.at("frame_of"), *b, want + suggestion(lay.frame_of, bodies));
+    }
+    lay.zoom = num(a, "zoom", closed(1.0, 50.0), "", 1.0);
+    if (lay.zoom != 1.0 && lay.frame_of.empty())
+      fail(c, a.at("zoom"), *a.opt("zoom"), "1 without /outputs/layout/frame_of (the view is enlarged about a body)");
+    lay.normalize = boolean(a, "normalize", false);
+    if (lay.normalize && reference_body_index(s) < 0)
+      fail(c, a.at("normalize"), *a.opt("normalize"), "false: the scales come from a moving body and none moves");
+    a.finish();
+  }
   out.force_interval_s = num(o, "force_interval_s", kNonNegative, "s", 0.0, ", 0 for every step");
   if (const json* w = o.opt("average_window")) {
     Obj a(c, *w, o.at("average_window"), kWindowKeys);

@@ -118,8 +118,9 @@ const KeyList kFrictionWallKeys = {"type", "friction"};
 const KeyList kPlainWallKeys = {"type"};
 const KeyList kEffectsKeys = {"gravity", "gravity_m_s2", "dilatancy", "separation", "body_friction",
                               "wall_friction", "rate_dependence"};
-const KeyList kOutputsKeys = {"frame_interval_s", "fields", "movies", "points", "force_interval_s",
+const KeyList kOutputsKeys = {"frame_interval_s", "fields", "movies", "points", "layout", "force_interval_s",
                               "average_window"};
+const KeyList kLayoutKeys = {"name", "fields", "frame_of", "zoom", "normalize"};
 const KeyList kWindowKeys = {"from_s", "to_s", "from_m", "to_m"};
 
 const KeyList kModels = {"ndpm", "dpm"};  // enum orders of scene.hpp
@@ -268,6 +269,7 @@ std::vector<std::string> schema_keys(const json& root, const std::string& pointe
     if (is(0, "walls") && is(1, "front_back")) return kFrontBackKeys;
     if (is(0, "walls")) return wall_keys(here);
     if (is(0, "outputs") && is(1, "average_window")) return kWindowKeys;
+    if (is(0, "outputs") && is(1, "layout")) return kLayoutKeys;
     return {};
   }
   if (!is(0, "bodies")) return {};

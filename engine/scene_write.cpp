@@ -148,6 +148,15 @@ J to_json(const Scene& s) {
   out["fields"] = s.outputs.fields;
   out["movies"] = s.outputs.movies;
   out["points"] = s.outputs.points;
+  if (!s.outputs.layout.name.empty()) {
+    J lay = J::object();
+    lay["name"] = s.outputs.layout.name;
+    lay["fields"] = s.outputs.layout.fields;
+    lay["frame_of"] = s.outputs.layout.frame_of.empty() ? J(nullptr) : J(s.outputs.layout.frame_of);
+    lay["zoom"] = s.outputs.layout.zoom;
+    lay["normalize"] = s.outputs.layout.normalize;
+    out["layout"] = lay;
+  }
   out["force_interval_s"] = s.outputs.force_interval_s;
   J window = J::object();
   if (s.outputs.average_from_m >= 0.0) {
