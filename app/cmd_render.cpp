@@ -293,7 +293,14 @@ int render_main(const Parsed& p) {
       const fs::path scene_path = fs::path(runs[several_runs ? k : 0]) / "scene.json";
       if (!fs::exists(scene_path))
         throw std::runtime_error("--normalize: " + scene_path.string() + " does not exist (it names the body's speed and size)");
-      const render::BodyScales sc = render::body_scales(load_scene(scene_path.string()), scene_path.string());
+      const Scene run_scene = load_scene(scene_path.string());
+      if (!p.has("--normalize") && reference_body_index(run_scene) < 0) {
+        // the layout asks for it, but no body moves in this run: drawn in units
+        if (k == 0) std::cerr << "furrow render: " << scene_path.string() << ": no body moves; drawn in units\n";
+        panels_style.fields.push_back(s);
+        continue;
+      }
+      const render::BodyScales sc = render::body_scales(run_scene, scene_path.string());
       render::normalize_style(sc, &s);
       if (k == 0) normalized = render::scales_text(sc);
     }
@@ -508,7 +515,7 @@ Command command_render() {
            {"--overwrite", false, false, "replace an existing output"},
            {"--range", true, false, "fixed colour range instead of the frames' min..max (one field only)", "LO:HI"},
            {"--colormap", true, false, "viridis, magma or coolwarm (default: by field; one field only)", "NAME"},
-           {"--fps", true, false, "movie frames per second (default: the frames over 10 s, 2..30)", "N"},
+           {"--fps", true, false, "movie frames per second (default: the frames over 10 s, 2..60)", "N"},
            {"--labels", true, false, "panel titles of several runs, comma-separated (default: folder names)", "LIST"},
            {"--frame-of", true, false, "follow this body: it stays still in the image", "BODY"},
            {"--zoom", true, false, "with --frame-of: enlarge the view about the body (1..50, default 1)", "F"},

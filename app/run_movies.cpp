@@ -1,5 +1,6 @@
 #include "app/run_movies.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -34,7 +35,16 @@ void render_run_movies(const std::string& run_dir, const Scene& scene, bool quie
     render::render_movie(paths, style, out, render::movie_fps(paths.size()), false);
     if (!quiet) std::cerr << "movie: " << out << " (" << paths.size() << " frames)\n";
   }
-  if (!scene.outputs.layout.name.empty()) {
+  const MovieLayout& lay = scene.outputs.layout;
+  std::string unstored;  // a layout field this run did not store (velocity_x/y read velocity)
+  for (const auto& f : lay.fields) {
+    const std::string stored = f.rfind("velocity_", 0) == 0 ? "velocity" : f;
+    if (std::find(scene.outputs.fields.begin(), scene.outputs.fields.end(), stored) == scene.outputs.fields.end())
+      unstored = f;
+  }
+  if (!lay.name.empty() && !unstored.empty() && !quiet)
+    std::cerr << "movie: " << lay.name << " left out: its field '" << unstored << "' is not stored in this run\n";
+  if (!lay.name.empty() && unstored.empty()) {
     // the paper's layout of this case: the same path as `furrow render RUN_DIR --layout`
     static const Command render = command_render();
     Parsed layout;

@@ -111,13 +111,7 @@ void write_points(const std::string& path, const PointFrameInfo& info, const Poi
   meta.insertMeta("point_count", openvdb::Int64Metadata(int64_t(n)));
 
   openvdb::GridPtrVec grids{grid};
-  write_atomically(path, [&](const std::string& tmp) {
-    openvdb::io::File file(tmp);
-    if (openvdb::io::Archive::hasBloscCompression())
-      file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-    file.write(grids, meta);
-    file.close();
-  });
+  vdb_detail::write_vdb(path, grids, meta);
 }
 
 std::function<float(size_t)> from(const std::vector<float>& v) {

@@ -36,8 +36,8 @@ nlohmann::json result_defining_json(const Scene& scene) {
   Scene s = scene;
   s.solver.threads = 0;
   s.outputs.movies.clear();  // drawn from the stored frames after the run; a sweep skips them
-  s.outputs.layout = {};     // likewise
   nlohmann::json j = scene_to_json(s);
+  j["outputs"].erase("layout");  // drawn from the stored frames too; scenes keep the hash they had before it
   // the key's absence reads as false: scenes without points keep the hash they had before it
   if (!s.outputs.points) j["outputs"].erase("points");
   return j;

@@ -108,7 +108,8 @@ struct Effects {
 // movies/<name>.mp4; `furrow render RUN --layout` renders it again (of several runs too).
 struct MovieLayout {
   std::string name;                 // movies/<name>.mp4; "" when the scene has no layout
-  std::vector<std::string> fields;  // stored fields, or the velocity's components velocity_x / velocity_y
+  std::vector<std::string> fields;  // field names, or the velocity's components velocity_x / velocity_y; a
+                                    // run that does not store them all renders no layout movie
   std::string frame_of;             // a body's name: the body stays still in the image; "" for none
   double zoom = 1.0;                // with frame_of: the view enlarged about the body
   bool normalize = false;           // velocity / v, strain rate / (v/L), time t v/L (first moving body)

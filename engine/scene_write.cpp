@@ -148,6 +148,7 @@ J to_json(const Scene& s) {
   out["fields"] = s.outputs.fields;
   out["movies"] = s.outputs.movies;
   out["points"] = s.outputs.points;
+  out["layout"] = nullptr;  // none: resolved scenes list every key
   if (!s.outputs.layout.name.empty()) {
     J lay = J::object();
     lay["name"] = s.outputs.layout.name;

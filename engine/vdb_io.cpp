@@ -102,13 +102,7 @@ void write_frame_vdb(const std::string& path, const FieldFrame& f) {
   meta.insertMeta("origin_x_m", openvdb::DoubleMetadata(f.origin_m.x()));
   meta.insertMeta("origin_y_m", openvdb::DoubleMetadata(f.origin_m.y()));
 
-  write_atomically(path, [&](const std::string& tmp) {
-    openvdb::io::File file(tmp);
-    if (openvdb::io::Archive::hasBloscCompression())
-      file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-    file.write(grids, meta);
-    file.close();
-  });
+  vdb_detail::write_vdb(path, grids, meta);
 }
 
 namespace {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/field_store.hpp"
 #include "engine/fields.hpp"
 
 namespace furrow::vdb_detail {
@@ -103,6 +104,17 @@ inline VdbContents read_vdb(const std::string& path, const char* who) {
     throw std::runtime_error(std::string(who) + ": " + path + ": not a readable OpenVDB file (" + e.what() + ")");
   }
   return c;
+}
+
+// Writes grids and file metadata to `path` atomically, Blosc-compressed when OpenVDB has it.
+inline void write_vdb(const std::string& path, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta) {
+  write_atomically(path, [&](const std::string& tmp) {
+    openvdb::io::File file(tmp);
+    if (openvdb::io::Archive::hasBloscCompression())
+      file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+    file.write(grids, meta);
+    file.close();
+  });
 }
 
 }  // namespace furrow::vdb_detail

@@ -267,7 +267,7 @@ RgbImage render_contact_sheet(const std::vector<std::string>& paths, const Panel
 namespace furrow::render {
 
 double movie_fps(size_t frames) {
-  return std::clamp(double(frames) / kMovieSeconds, 2.0, 30.0);
+  return std::clamp(double(frames) / kMovieSeconds, 2.0, 60.0);
 }
 
 void render_movie(const std::vector<std::vector<std::string>>& runs, const PanelsStyle& style,

@@ -27,8 +27,8 @@ int time_decimals_for(const std::vector<double>& times_s);
 
 using FrameProgress = std::function<void(size_t done, size_t total)>;
 
-// Frames per second that make a movie of `frames` frames last about kMovieSeconds (5-20 s for
-// 10-600 frames; at least 2 and at most 30 frames per second).
+// Frames per second that make a movie of `frames` frames last about kMovieSeconds: 10 s for 20-600
+// frames, 20 s for 1200; at least 2 and at most 60 frames per second (which browsers play).
 constexpr double kMovieSeconds = 10.0;
 double movie_fps(size_t frames);
 

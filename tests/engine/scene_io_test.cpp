@@ -315,7 +315,7 @@ std::vector<BadCase> bad_cases() {
       {"huge step count", plain("hydrostatic_bed"), {"solver.end_time_s=200"}, "/solver/end_time_s", "steps"},
       {"bad field name", with(P, [](json& j) { j["outputs"]["fields"][0] = "strain"; }), {}, "/outputs/fields/0", "field name"},
       {"movie not in fields", with(P, [](json& j) { j["outputs"]["movies"] = {"velocity"}; }), {}, "/outputs/movies/0", "/outputs/fields"},
-      {"phi_d on NDPM", with(P, [](json& j) { j["outputs"]["fields"].push_back("phi_d"); }), {}, "/outputs/fields/3", "DPM"},
+      {"phi_d on NDPM", with(P, [](json& j) { j["outputs"]["fields"].push_back("phi_d"); }), {}, "/outputs/fields/4", "DPM"},
       {"fields without frames", with(P, [](json& j) { j["outputs"]["frame_interval_s"] = 0; }), {}, "/outputs/frame_interval_s", "> 0"},
       {"chi on NDPM", with(P, [](json& j) { j["materials"][0]["chi"] = 2.5; }), {}, "/materials/0/chi", "DPM-only"},
       {"mu_s on DPM", with(D, [](json& j) { j["materials"][0]["mu_s"] = 0.4; }), {}, "/materials/0/mu_s", "mu_c"},
