@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "render/frame_renderer.hpp"
+#include "render/point_splat.hpp"
 #include "tests/render/synthetic_frames.hpp"
 
 using namespace furrow;
@@ -49,12 +50,39 @@ void run(benchmark::State& state, bool with_panel, bool smooth = true) {
   }
   state.counters["cells"] = double(f.nx) * f.ny;
 }
+// The material points drawn as discs: 3.2 x 10^5 points (4 a cell in the material) splatted at 4 texels a cell
+// and drawn, as `furrow render --points` does each frame.
+void run_points(benchmark::State& state) {
+  FrameStyle style;
+  style.field = "pressure";
+  style.smooth = false;
+  style.range = {0.0, test::kRhoBulk_kg_m3 * test::kG_m_s2 * 0.5, false};
+  FrameRenderer r(style);
+  const FieldFrame grid = bench_frame();
+  PointFrame pts;
+  pts.dx_m = grid.dx_m;
+  pts.bodies = grid.bodies;
+  for (int j = 0; j < 2 * 200; ++j)
+    for (int i = 0; i < 2 * grid.nx; ++i) {
+      pts.x_m.push_back((i + 0.5) * grid.dx_m / 2), pts.y_m.push_back((j + 0.5) * grid.dx_m / 2);
+      pts.vx_m_s.push_back(0.f), pts.vy_m_s.push_back(0.f);
+      pts.volume_m2.push_back(float(grid.dx_m * grid.dx_m / 4));
+      pts.pressure_Pa.push_back(float(test::kRhoBulk_kg_m3 * test::kG_m_s2 * (0.5 - pts.y_m.back())));
+    }
+  for (auto _ : state) {
+    RgbImage img = r.render(splat_points(pts, grid, 4, {"pressure"}, "bench"));
+    benchmark::DoNotOptimize(img.rgb.data());
+  }
+  state.counters["points"] = double(pts.size());
+}
 }  // namespace
 
 static void BM_RenderFrame1280x720(benchmark::State& s) { run(s, false); }
+static void BM_RenderPoints1280x720(benchmark::State& s) { run_points(s); }
 static void BM_RenderFrame1280x720_ForcePanel(benchmark::State& s) { run(s, true); }
 static void BM_RenderFrame1280x720_Cells(benchmark::State& s) { run(s, false, false); }
 BENCHMARK(BM_RenderFrame1280x720)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_RenderFrame1280x720_ForcePanel)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_RenderFrame1280x720_Cells)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_RenderPoints1280x720)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_MAIN();
