@@ -228,11 +228,13 @@ int render_main(const Parsed& p) {
     }
     run_frames.front().resize(n);
     // frames pair by index; their times must agree (same frame interval and start)
+    double t_before = 0.0;  // run 0's previous frame time: each file is read once
     for (size_t k = 0; k < n; ++k) {
       const double t0 = read_frame(run_frames[0][k]).time_s;
+      const double gap = k > 0 ? t0 - t_before : t0;
+      t_before = t0;
       for (size_t r = 1; r < runs.size(); ++r) {
         const double t = read_frame(run_frames[r][k]).time_s;
-        const double gap = k > 0 ? t0 - read_frame(run_frames[0][k - 1]).time_s : t0;
         if (std::abs(t - t0) > 1e-9 + 0.25 * std::abs(gap)) {
           std::cerr << "furrow render: frames do not pair by time: " << run_frames[0][k] << " is at t = " << t0
                     << " s, " << run_frames[r][k] << " at t = " << t << " s (store frames at the same interval)\n";
