@@ -309,10 +309,11 @@ int render_main(const Parsed& p) {
     panels_style.fields.push_back(s);
   }
   style = panels_style.fields.front();
-  // a run's force panel: each body's trace averaged over one cell of travel, over its raw trace
+  // a run's force panel: each body's raw trace, or with --force-mean its average over one cell of
+  // travel drawn over it
   auto panel_of = [&](size_t r) {
     const render::ForcePanel raw = render::read_force_panel((fs::path(runs[r]) / "forces.csv").string());
-    if (p.has("--raw-force")) return raw;
+    if (!p.has("--force-mean")) return raw;
     const double dx_mm = 1000.0 * read_frame(grid_frames[r].front()).dx_m;
     char text[64];
     std::snprintf(text, sizeof text, "1 cell = %.3g mm", dx_mm);
@@ -478,7 +479,8 @@ Command command_render() {
           "each cell as one flat colour instead. Movies and PNGs show a side panel from RUN_DIR/forces.csv when it exists:\n"
           "for each body, the resisting force -F.d (d = unit direction of its travel from first to last\n"
           "position; Fy for a plate pushed down) against its displacement from its first position,\n"
-          "drawn as its running mean over one cell of travel over the faint raw trace (--raw-force: raw only).\n"
+          "every step as recorded (--force-mean: its running mean over one cell of travel over the faint\n"
+          "raw trace).\n"
           "\n"
           "Several runs (furrow render RUN_A RUN_B --field strain_rate --labels loose,dense) are drawn\n"
           "side by side, one field, one colour range over all of them, each panel titled by its label and\n"
@@ -523,7 +525,7 @@ Command command_render() {
            {"--zoom", true, false, "with --frame-of: enlarge the view about the body (1..50, default 1)", "F"},
            {"--normalize", false, false, "dimensionless velocity (/v), strain rate (/(v/L)) and time (t v/L)"},
            {"--no-panel", false, false, "leave out the force panel"},
-           {"--raw-force", false, false, "force panel: every step only (default: one cell's running mean over it)"},
+           {"--force-mean", false, false, "force panel: one cell's running mean over the faint raw trace (default: raw)"},
            {"--layout", false, false, "the paper's layout the run's scene names (outputs.layout): fields, frame, scales"},
            {"--points", false, false, "draw the stored material points (outputs.points) as discs coloured by their own value"},
            {"--cells", false, false, "draw each cell as one flat colour (default: blended within the material)"},

@@ -1,7 +1,6 @@
 #include "app/run_movies.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <stdexcept>
@@ -19,10 +18,9 @@ void render_run_movies(const std::string& run_dir, const Scene& scene, bool quie
   if (scene.outputs.movies.empty() && scene.outputs.layout.name.empty()) return;
   const auto paths = list_frames(run_dir);
   if (paths.empty()) return;
-  char window[64];
-  std::snprintf(window, sizeof window, "1 cell = %.3g mm", 1000.0 * scene.domain.dx_m);
-  const render::ForcePanel panel = render::with_running_mean(
-      render::read_force_panel((fs::path(run_dir) / "forces.csv").string()), 1000.0 * scene.domain.dx_m, window);
+  // the raw trace: since the safety net stopped kicking points (2026-12-04) it carries no single-step
+  // ticks, and what fluctuates in it is the flow's
+  const render::ForcePanel panel = render::read_force_panel((fs::path(run_dir) / "forces.csv").string());
   fs::create_directories(fs::path(run_dir) / "movies");
   for (const auto& field : scene.outputs.movies) {
     const render::FrameScan scan = render::scan_frames(paths, field);

@@ -169,7 +169,7 @@ ForceSmoothness force_smoothness(const std::vector<double>& s, const std::vector
                                  double from_m, double to_m, double bin_m) {
   if (s.size() != F.size()) throw std::invalid_argument("force_smoothness: travel and force have different lengths");
   ForceSmoothness r;
-  r.mean_N_per_m = r.peak_ratio = r.peak_at_m = r.rms_relative = r.cell_amplitude_relative = kNaN;
+  r.mean_N_per_m = r.peak_ratio = r.peak_at_m = r.rms_relative = r.cell_amplitude_relative = r.tick_max_relative = kNaN;
   std::vector<double> prefix(s.size() + 1, 0.0);
   for (size_t k = 0; k < s.size(); ++k) prefix[k + 1] = prefix[k] + F[k];
   double sum = 0.0, dev2 = 0.0;
@@ -189,6 +189,10 @@ ForceSmoothness force_smoothness(const std::vector<double>& s, const std::vector
   if (r.samples == 0) return r;
   r.mean_N_per_m = sum / double(r.samples);
   r.rms_relative = std::sqrt(dev2 / double(r.samples)) / std::abs(r.mean_N_per_m);
+  double tick = 0.0;
+  for (size_t k = 1; k + 1 < s.size(); ++k)
+    if (s[k - 1] >= from_m && s[k + 1] <= to_m) tick = std::max(tick, std::abs(F[k] - 0.5 * (F[k - 1] + F[k + 1])));
+  r.tick_max_relative = tick / std::abs(r.mean_N_per_m);
   // binned and detrended as drag_statistics does, then projected on the cell period
   const Binned bd = bin_and_detrend(s, F, from_m, to_m, bin_m);
   double c = 0.0, q = 0.0;

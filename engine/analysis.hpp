@@ -97,7 +97,10 @@ DragStats drag_statistics(const std::vector<double>& travel_m, const std::vector
 //   running mean M_k = mean of the samples within half a cell of travel of sample k;
 //   peak_ratio = max F_k / M_k; rms_relative = RMS(F_k - M_k) / mean F;
 //   cell_amplitude_relative = amplitude of the component of period `cell_m` (least-squares sine
-//   and cosine) in the force binned every `bin_m` of travel and detrended, over its mean.
+//   and cosine) in the force binned every `bin_m` of travel and detrended, over its mean;
+//   tick_max_relative = max |F_k - (F_(k-1) + F_(k+1)) / 2| / mean F over samples whose
+//   neighbours are in the window too: a single-step kick, which no flow makes (a flow changes the
+//   force over many steps, so this reads a few tenths of a percent at most where no step kicks).
 struct ForceSmoothness {
   int64_t samples = 0;
   double mean_N_per_m = 0.0;
@@ -105,6 +108,7 @@ struct ForceSmoothness {
   double peak_at_m = 0.0;  // travel of the peak
   double rms_relative = 0.0;
   double cell_amplitude_relative = 0.0;
+  double tick_max_relative = 0.0;
 };
 // travel_m non-decreasing; NaN fields when the window holds no sample.
 ForceSmoothness force_smoothness(const std::vector<double>& travel_m, const std::vector<double>& force_N_per_m,

@@ -208,7 +208,6 @@ class Simulation {
   void contact_walls();
   void front_back_friction();
   struct G2PLocal {
-    std::vector<Vec2> impulse;  // per body: the safety net's projections
     int64_t projected = 0;
     double vmax2 = 0.0;
     bool strayed = false;  // a point left its strip's window (the step ends with a reorder)

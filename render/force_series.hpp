@@ -15,10 +15,10 @@ namespace furrow::render {
 // Throws std::runtime_error naming the file and line for a missing column or a malformed row.
 ForcePanel read_force_panel(const std::string& forces_csv_path);
 
-// The panel as the paper would print it: each series' running mean over `window` of travel (in
-// the panel's x units; one cell, so the single-step kicks of points riding a body's face and the
-// cell's own ripple average out) drawn over the raw trace, which stays as a faint line behind it.
-// The title says so. A panel against time (no body moves) or window <= 0 is returned unchanged.
+// Each series' running mean over `window` of travel (in the panel's x units; one cell, so what is
+// left of the cell's own ripple averages out) drawn over the raw trace, which stays as a faint line
+// behind it (`furrow render --force-mean`). The title says so. A panel against time (no body
+// moves) or window <= 0 is returned unchanged.
 ForcePanel with_running_mean(const ForcePanel& panel, double window, const std::string& window_text);
 
 }  // namespace furrow::render

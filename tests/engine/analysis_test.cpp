@@ -360,3 +360,19 @@ TEST(RunAnalysis, NothingForScenesWithoutMovingBodies) {
   EXPECT_FALSE(a.wants_frames());
   EXPECT_TRUE(a.to_json().is_null());
 }
+
+// A single-step kick stands out from its neighbours' mean; a fluctuation of the flow (here 3% at a
+// period of 6 mm of travel, 600 samples a period) does not, however large its RMS.
+TEST(ForceSmoothness, TickMeasureSeparatesSingleStepKicksFromSlowFluctuations) {
+  const double kPi = 3.14159265358979323846;
+  auto flow = [&](double s) { return 1000.0 * (1.0 + 0.03 * std::sin(2 * kPi * s / 0.006)); };
+  const Signal smooth = sample(flow, 1e-5, 0.1);
+  Signal kicked = smooth;
+  for (size_t k = 150; k < kicked.f.size(); k += 300) kicked.f[k] += 100.0;  // +10% every 3 mm
+  const ForceSmoothness a = force_smoothness(smooth.s, smooth.f, 0.01, 0.02, 0.08);
+  const ForceSmoothness b = force_smoothness(kicked.s, kicked.f, 0.01, 0.02, 0.08);
+  // the slow part's second difference: 0.03 (2 pi ds / period)^2 / 2 = 1.6e-5 of the mean
+  EXPECT_LT(a.tick_max_relative, 1e-4);
+  EXPECT_GT(a.rms_relative, 0.01);  // the flow's own fluctuation: not what the tick measure sees
+  EXPECT_NEAR(b.tick_max_relative, 0.1, 0.005);
+}

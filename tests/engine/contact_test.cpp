@@ -42,9 +42,10 @@ Trace run_template(const std::string& name, double travel_m, ContactMethod conta
 }
 
 void report(const char* what, const ForceSmoothness& f) {
-  std::printf("%s: mean %.1f N/m, peak/one-cell mean %.3f at %.1f mm, RMS about it %.2f%%, cell-period component %.2f%%\n",
+  std::printf("%s: mean %.1f N/m, peak/one-cell mean %.3f at %.1f mm, RMS about it %.2f%%, cell-period component %.2f%%, "
+              "largest single-step tick %.2f%%\n",
               what, f.mean_N_per_m, f.peak_ratio, 1e3 * f.peak_at_m, 100 * f.rms_relative,
-              100 * f.cell_amplitude_relative);
+              100 * f.cell_amplitude_relative, 100 * f.tick_max_relative);
 }
 
 // plate_intrusion at its preview dx over its averaging window (45..85 mm of travel)
