@@ -182,7 +182,8 @@ Command command_run() {
             "furrow run SCENE.json [--out DIR] [--set key.path=value ...] [--force]",
             "Runs the scene and writes DIR (default out/<scene name>):\n"
             "  scene.json   the scene as run, every default filled in\n"
-            "  forces.csv   t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m (force of the media on each body,\n"
+            "  forces.csv   t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m,torque_N_m_per_m,angle_deg,vx_m_s,vy_m_s,\n"
+            "               omega_rad_s (force and torque of the media on each body,\n"
             "               per metre out of plane; averaged over outputs.force_interval_s)\n"
             "  frames/      frame_NNNNN.vdb (OpenVDB) and .vti, with frames.pvd for ParaView; with\n"
             "               outputs.points, points_NNNNN.vdb: the material points (OpenVDB point data)\n"

@@ -208,6 +208,7 @@ std::vector<std::vector<ForceSample>> read_forces_csv(const std::string& path, c
     s.t_s = std::strtod(f[0].c_str(), nullptr);
     s.position_m = Vec2(std::strtod(f[2].c_str(), nullptr), std::strtod(f[3].c_str(), nullptr));
     s.force_N_per_m = Vec2(std::strtod(f[4].c_str(), nullptr), std::strtod(f[5].c_str(), nullptr));
+    if (f.size() > 6) s.torque_N = std::strtod(f[6].c_str(), nullptr);
     out[it->second].push_back(s);
   }
   return out;
@@ -363,7 +364,7 @@ RunMetrics run_metrics(const Scene& scene, const RunSummary& summary,
 
     // time-weighted mean over the window; each row averages the forces since the previous row
     Vec2 sum(0, 0);
-    double span = 0.0;
+    double span = 0.0, torque_sum = 0.0, sinkage_sum = 0.0;
     std::vector<double> travel, drag, bottom_depth;
     const Bed* own = bed_under(scene, body.start_m.x());
     const double surface = own ? own->max_m.y() : m.surface_y_m;
@@ -373,6 +374,8 @@ RunMetrics run_metrics(const Scene& scene, const RunSummary& summary,
       t_prev = r.t_s;
       if (r.t_s >= m.window_from_s - 1e-12 && r.t_s <= m.window_to_s + 1e-12 && dt > 0.0) {
         sum += r.force_N_per_m * dt;
+        torque_sum += r.torque_N * dt;
+        sinkage_sum += (body.start_m.y() - r.position_m.y()) * dt;
         span += dt;
       }
       const double d = -r.force_N_per_m.dot(u);
@@ -381,6 +384,8 @@ RunMetrics run_metrics(const Scene& scene, const RunSummary& summary,
       bottom_depth.push_back(surface - (r.position_m.y() + bounds.first.y()));
     }
     bm.mean_N_per_m = span > 0.0 ? Vec2(sum / span) : Vec2(kNaN, kNaN);
+    bm.mean_torque_N = span > 0.0 ? torque_sum / span : kNaN;
+    bm.sinkage_m = span > 0.0 ? sinkage_sum / span : kNaN;
     bm.mean_drag_N_per_m = -bm.mean_N_per_m.dot(u);
     bm.mean_lift_N_per_m = bm.mean_N_per_m.dot(n);
     // smoothing over two cells of travel removes the cell-crossing ripple (period one cell)
@@ -530,6 +535,10 @@ std::vector<Column> columns(const std::vector<Vary>& varies, const std::vector<S
         [](const BodyMetrics& b) { return b.depth_m; });
     add("mean_Fx_N_per_m", "mean Fx over the window (N/m)", [](const BodyMetrics& b) { return b.mean_N_per_m.x(); });
     add("mean_Fy_N_per_m", "mean Fy over the window (N/m)", [](const BodyMetrics& b) { return b.mean_N_per_m.y(); });
+    add("mean_torque_N_m_per_m", "mean torque of the media on the body about its origin over the window, "
+        "counter-clockwise (N m/m)", [](const BodyMetrics& b) { return b.mean_torque_N; });
+    add("sinkage_m", "mean over the window of how far the body's origin is below its start (m)",
+        [](const BodyMetrics& b) { return b.sinkage_m; });
     add("mean_drag_N_per_m", "mean drag -F.u over the window, u the direction of motion (N/m)",
         [](const BodyMetrics& b) { return b.mean_drag_N_per_m; });
     add("mean_lift_N_per_m", "mean lift F.n over the window, n = u turned +90 degrees (N/m)",

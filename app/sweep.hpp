@@ -54,6 +54,7 @@ struct ForceSample {
   double t_s = 0.0;
   Vec2 position_m{0, 0};
   Vec2 force_N_per_m{0, 0};
+  double torque_N = 0.0;  // N m per metre about the body's origin (0 in files written before torque)
 };
 
 // Reads a run's forces.csv: samples[b] for each body b of the scene, in time order.
@@ -79,6 +80,8 @@ struct BodyMetrics {
   double size_m = 0.0;            // circle: D; box: width L (x extent); others: x extent
   double depth_m = 0.0;           // see sweep.csv docs (circle: centre; box: bottom at window mid)
   double F0_N_per_m = 0.0;        // characteristic force of the normalized columns (NaN if undefined)
+  double mean_torque_N = 0.0;     // N m per metre over the window, counter-clockwise about the origin
+  double sinkage_m = 0.0;         // mean over the window of how far the origin is below its start
 };
 
 // The pair quantities of the paper's case 2 (first two moving boxes, left to right).

@@ -108,4 +108,19 @@ double shape_min_size(const Shape& s) {
   return 0.0;
 }
 
+ShapeMass shape_mass_properties(const Shape& s) {
+  const auto [lo, hi] = shape_bounds_m(s);
+  constexpr int kN = 512;
+  const Vec2 h = (hi - lo) / kN;
+  ShapeMass m;
+  for (int j = 0; j < kN; ++j)
+    for (int i = 0; i < kN; ++i) {
+      const Vec2 q = lo + Vec2((i + 0.5) * h.x(), (j + 0.5) * h.y());
+      if (shape_sdf(s, q) >= 0.0) continue;
+      m.area_m2 += h.x() * h.y();
+      m.second_moment_m4 += q.squaredNorm() * h.x() * h.y();
+    }
+  return m;
+}
+
 }  // namespace furrow

@@ -14,6 +14,13 @@ Vec2 shape_normal(const Shape& s, const Vec2& q, double h);
 std::vector<std::vector<Vec2>> shape_outline(const Shape& s, int circle_segments = 48);
 // Smallest feature size (circle diameter, box min side, polygon min extent).
 double shape_min_size(const Shape& s);
+// Area (m^2 per metre) and second moment of area about the body's origin (m^4 per metre), by
+// midpoint quadrature on a 512 x 512 grid over its bounds: a union's overlaps count once. Relative
+// error ~1e-4 for a circle (its edge cells).
+struct ShapeMass {
+  double area_m2 = 0.0, second_moment_m4 = 0.0;
+};
+ShapeMass shape_mass_properties(const Shape& s);
 // (bounds and prescribed motion: shape_bounds_m, motion_velocity_m_s, motion_displacement_m in
 // engine/scene_io.hpp, shared with scene validation)
 

@@ -93,15 +93,18 @@ class ForceLog {
   ForceLog(const std::string& path, const Scene& s, const nlohmann::json& state)
       : path_(path), interval_s_(s.outputs.force_interval_s) {
     sum_.assign(s.bodies.size(), Vec2(0, 0));
+    torque_sum_.assign(s.bodies.size(), 0.0);
     for (const auto& b : s.bodies) names_.push_back(b.name);
     if (state.is_null()) {
       out_.open(path, std::ios::trunc);
-      out_ << "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m\n";
+      out_ << kForcesHeader << "\n";
     } else {
       fs::resize_file(path, state.at("bytes").get<uintmax_t>());
       out_.open(path, std::ios::app);
       span_s_ = state.at("span_s").get<double>();
       for (size_t b = 0; b < sum_.size(); ++b) sum_[b] = Vec2(state.at("sum")[b][0], state.at("sum")[b][1]);
+      if (state.contains("torque_sum"))
+        for (size_t b = 0; b < sum_.size(); ++b) torque_sum_[b] = state.at("torque_sum")[b].get<double>();
     }
     if (!out_) throw std::runtime_error(path + ": cannot open for writing");
   }
@@ -109,20 +112,26 @@ class ForceLog {
     const auto& bodies = sim.bodies();
     if (bodies.empty()) return;
     const double dt = sim.last_dt_s();
-    for (size_t b = 0; b < bodies.size(); ++b) sum_[b] += bodies[b].force_N_per_m * dt;
+    for (size_t b = 0; b < bodies.size(); ++b) {
+      sum_[b] += bodies[b].force_N_per_m * dt;
+      torque_sum_[b] += bodies[b].torque_N * dt;
+    }
     span_s_ += dt;
     if (span_s_ >= interval_s_ - 1e-15) flush(sim);
   }
   void flush(const Simulation& sim) {
     if (span_s_ <= 0.0) return;
-    char line[256];
+    char line[512];
     for (size_t b = 0; b < sum_.size(); ++b) {
       const Vec2 f = sum_[b] / span_s_;
-      const Vec2 x = sim.bodies()[b].position_m;
-      std::snprintf(line, sizeof line, "%.9g,%s,%.9g,%.9g,%.9g,%.9g\n", sim.time_s(), names_[b].c_str(),
-                    x.x(), x.y(), f.x(), f.y());
+      const BodyState& body = sim.bodies()[b];
+      const Vec2 x = body.position_m, v = body.velocity_m_s;
+      std::snprintf(line, sizeof line, "%.9g,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", sim.time_s(),
+                    names_[b].c_str(), x.x(), x.y(), f.x(), f.y(), torque_sum_[b] / span_s_,
+                    body.angle_rad * 180.0 / M_PI, v.x(), v.y(), body.omega_rad_s);
       out_ << line;
       sum_[b].setZero();
+      torque_sum_[b] = 0.0;
     }
     span_s_ = 0.0;
   }
@@ -131,7 +140,7 @@ class ForceLog {
     if (!out_) throw std::runtime_error(path_ + ": write failed");
     nlohmann::json sum = nlohmann::json::array();
     for (const Vec2& v : sum_) sum.push_back({v.x(), v.y()});
-    return {{"bytes", fs::file_size(path_)}, {"span_s", span_s_}, {"sum", sum}};
+    return {{"bytes", fs::file_size(path_)}, {"span_s", span_s_}, {"sum", sum}, {"torque_sum", torque_sum_}};
   }
   void close() {
     out_.close();
@@ -143,6 +152,7 @@ class ForceLog {
   std::ofstream out_;
   double interval_s_ = 0.0, span_s_ = 0.0;
   std::vector<Vec2> sum_;
+  std::vector<double> torque_sum_;
   std::vector<std::string> names_;
 };
 
@@ -156,6 +166,7 @@ class ForceStats {
       bodies_.push_back(f);
     }
     sums_.assign(s.bodies.size(), Vec2(0, 0));
+    torque_sums_.assign(s.bodies.size(), 0.0);
   }
   void add(const Simulation& sim) {
     const double t = sim.time_s(), d = sim.lead_body_travel_m(), dt = sim.last_dt_s();
@@ -165,8 +176,11 @@ class ForceStats {
       auto& s = bodies_[b];
       for (int c = 0; c < 2; ++c)
         if (std::abs(f[c]) > std::abs(s.peak_N_per_m[c])) s.peak_N_per_m[c] = f[c];
+      const double torque = sim.bodies()[b].torque_N;
+      if (std::abs(torque) > std::abs(s.peak_torque_N)) s.peak_torque_N = torque;
       if (in_window) {
         sums_[b] += f * dt;
+        torque_sums_[b] += torque * dt;
         ++s.window_samples;
       }
     }
@@ -177,6 +191,8 @@ class ForceStats {
     for (size_t k = 0; k < bodies_.size(); ++k)
       b.push_back({{"peak", {bodies_[k].peak_N_per_m.x(), bodies_[k].peak_N_per_m.y()}},
                    {"sum", {sums_[k].x(), sums_[k].y()}},
+                   {"peak_torque", bodies_[k].peak_torque_N},
+                   {"torque_sum", torque_sums_[k]},
                    {"samples", bodies_[k].window_samples}});
     return {{"bodies", b}, {"window_s", window_s_}};
   }
@@ -186,13 +202,17 @@ class ForceStats {
       const auto& b = j.at("bodies").at(k);
       bodies_[k].peak_N_per_m = Vec2(b.at("peak")[0], b.at("peak")[1]);
       sums_[k] = Vec2(b.at("sum")[0], b.at("sum")[1]);
+      bodies_[k].peak_torque_N = b.value("peak_torque", 0.0);
+      torque_sums_[k] = b.value("torque_sum", 0.0);
       bodies_[k].window_samples = b.at("samples").get<int64_t>();
     }
   }
   std::vector<BodyForceSummary> finish() {
-    for (size_t b = 0; b < bodies_.size(); ++b)
-      bodies_[b].mean_N_per_m = window_s_ > 0.0 ? Vec2(sums_[b] / window_s_)
-                                                : Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    for (size_t b = 0; b < bodies_.size(); ++b) {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      bodies_[b].mean_N_per_m = window_s_ > 0.0 ? Vec2(sums_[b] / window_s_) : Vec2::Constant(nan);
+      bodies_[b].mean_torque_N = window_s_ > 0.0 ? torque_sums_[b] / window_s_ : nan;
+    }
     return bodies_;
   }
 
@@ -200,13 +220,12 @@ class ForceStats {
   const Outputs& out_;
   std::vector<BodyForceSummary> bodies_;
   std::vector<Vec2> sums_;
+  std::vector<double> torque_sums_;
   double window_s_ = 0.0;
 };
 
-nlohmann::json vec_json(const Vec2& v) {
-  auto num = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
-  return nlohmann::json::array({num(v.x()), num(v.y())});
-}
+nlohmann::json num_json(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+nlohmann::json vec_json(const Vec2& v) { return nlohmann::json::array({num_json(v.x()), num_json(v.y())}); }
 
 // The DIR.partial-* holding a checkpoint of this scene (the furthest along), or an empty path.
 fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene, bool any_build) {
@@ -509,11 +528,13 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   j["instruction_set"] = instruction_set();
   j["frames"] = frame_index;
   j["lead_body_travel_m"] = sim.lead_body_travel_m();
-  j["units"] = {{"force", "N/m (per metre out of plane)"}, {"time", "s"}, {"length", "m"}};
+  j["units"] = {{"force", "N/m (per metre out of plane)"}, {"torque", "N m/m, counter-clockwise, about the body's origin"}, {"time", "s"}, {"length", "m"}};
   for (const auto& b : summary.bodies)
     j["bodies"].push_back({{"name", b.name},
                            {"mean_force_N_per_m", vec_json(b.mean_N_per_m)},
                            {"peak_force_N_per_m", vec_json(b.peak_N_per_m)},
+                           {"mean_torque_N_m_per_m", num_json(b.mean_torque_N)},
+                           {"peak_torque_N_m_per_m", b.peak_torque_N},
                            {"window_steps", b.window_samples}});
   if (analysis.active()) j["analysis"] = analysis.to_json();
   if (collapse.active()) j["collapse"] = collapse.to_json();

@@ -47,10 +47,16 @@ struct RunOptions {
 };
 
 // Per-body force summary over the scene's averaging window.
+// forces.csv's header: force and torque (of the media on the body, about its origin, counter-
+// clockwise) averaged over the row's interval; position, angle and velocities at the row's time
+inline constexpr const char* kForcesHeader =
+    "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m,torque_N_m_per_m,angle_deg,vx_m_s,vy_m_s,omega_rad_s";
+
 struct BodyForceSummary {
   std::string name;
   Vec2 mean_N_per_m{0, 0};   // mean over the window (NaN when the window saw no step)
   Vec2 peak_N_per_m{0, 0};   // per component, the value of largest magnitude over the run
+  double mean_torque_N = 0.0, peak_torque_N = 0.0;  // N m per metre, likewise
   int64_t window_samples = 0;
 };
 

@@ -9,6 +9,7 @@
 namespace furrow {
 
 using Vec2 = Eigen::Vector2d;
+using Vec3 = Eigen::Vector3d;
 
 enum class ShapeFunction { Linear, Quadratic, Cubic };
 enum class MaterialModel { NDPM, DPM };
@@ -56,21 +57,41 @@ struct Shape {
   Vec2 offset_m{0.0, 0.0};             // position of this shape in its parent's frame
 };
 
+// Prescribed motion of a body's origin, and its rotation about it (counter-clockwise positive).
 struct Motion {
   enum class Kind { ConstantVelocity, Path };
   Kind kind = Kind::ConstantVelocity;
   Vec2 velocity_m_s{0.0, 0.0};
-  // piecewise-linear velocity in time: (t_s, vx, vy) knots; held constant after the last knot
-  struct Knot { double t_s; Vec2 velocity_m_s; };
+  double angular_velocity_rad_s = 0.0;
+  // piecewise-linear velocity in time: (t_s, vx, vy, omega) knots; held constant after the last knot
+  struct Knot {
+    double t_s;
+    Vec2 velocity_m_s;
+    double angular_velocity_rad_s = 0.0;
+  };
   std::vector<Knot> path;
+};
+
+// Degrees of freedom of a body that respond to the media (two-way coupling) instead of following
+// its motion; the motion then gives only their starting velocities.
+struct BodyDynamics {
+  bool free_x = false, free_y = false, free_angle = false;
+  double mass_kg_per_m = 0.0;    // per metre out of plane
+  double inertia_kg_m = 0.0;     // moment of inertia about the origin, kg m^2 per metre
+  Vec2 applied_force_N_per_m{0.0, 0.0};  // a constant load (a wheel's weight on its axle)
+  double applied_torque_N = 0.0;         // N m per metre: a motor's torque, counter-clockwise
+  bool any_free() const { return free_x || free_y || free_angle; }
 };
 
 struct Body {
   std::string name = "body";
   Shape shape;
   Vec2 start_m{0.0, 0.0};  // position of the shape's origin (box/circle centre) at t = 0
+  double start_angle_rad = 0.0;  // counter-clockwise
   Motion motion;
+  BodyDynamics dynamics;
   double friction = 0.35;  // mu_f, Coulomb, body against media
+  bool rotates() const;    // a start angle, an angular velocity or a free angle
 };
 
 struct Wall {

@@ -24,7 +24,12 @@ double estimate_time_step_s(const Scene& scene) {
   double c_max = 0.0;
   for (const auto& m : scene.materials) c_max = std::max(c_max, wave_speed_m_s(m));
   double v_max = 0.0;
-  for (const auto& b : scene.bodies) v_max = std::max(v_max, motion_max_speed_m_s(b.motion));
+  for (const auto& b : scene.bodies) {
+    // a turning body's surface moves faster than its origin, by up to omega x its reach
+    const auto [lo, hi] = shape_bounds_m(b.shape);
+    const double reach = lo.cwiseAbs().cwiseMax(hi.cwiseAbs()).norm();
+    v_max = std::max(v_max, motion_max_speed_m_s(b.motion) + motion_max_angular_speed_rad_s(b.motion) * reach);
+  }
   const double speed = c_max + v_max;
   // the fastest material bounds dt, i.e. dt minimised over materials
   return speed > 0.0 ? scene.solver.cfl * scene.domain.dx_m / speed : kInf;
@@ -63,36 +68,75 @@ double estimate_particle_steps(const Scene& scene) {
   return double(estimate_particle_count(scene)) * double(std::min<int64_t>(estimate_step_count(scene), scene.solver.max_steps));
 }
 
-Vec2 motion_velocity_m_s(const Motion& motion, double t_s) {
-  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty()) return motion.velocity_m_s;
+namespace {
+
+// A knot value (`get` of a knot) at t_s, linear between knots and held after the last; `constant`
+// for a constant_velocity motion.
+template <class T, class Get>
+T knot_interpolate(const Motion& motion, double t_s, const T& constant, Get get) {
+  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty()) return constant;
   const auto& k = motion.path;
-  if (t_s <= k.front().t_s) return k.front().velocity_m_s;
-  if (t_s >= k.back().t_s) return k.back().velocity_m_s;
+  if (t_s <= k.front().t_s) return get(k.front());
+  if (t_s >= k.back().t_s) return get(k.back());
   auto hi = std::upper_bound(k.begin(), k.end(), t_s,
                              [](double t, const Motion::Knot& knot) { return t < knot.t_s; });
   auto lo = hi - 1;
   const double a = (t_s - lo->t_s) / (hi->t_s - lo->t_s);
-  return (1.0 - a) * lo->velocity_m_s + a * hi->velocity_m_s;
+  return T((1.0 - a) * get(*lo) + a * get(*hi));
 }
 
-Vec2 motion_displacement_m(const Motion& motion, double t_s) {
-  if (t_s <= 0.0) return Vec2::Zero();
-  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty())
-    return motion.velocity_m_s * t_s;
-  // trapezoids are exact for a velocity linear between knots
-  Vec2 d = Vec2::Zero();
+// Its integral from 0 to t_s: trapezoids are exact for a value linear between knots.
+template <class T, class Get>
+T knot_integral(const Motion& motion, double t_s, const T& constant, const T& zero, Get get) {
+  if (t_s <= 0.0) return zero;
+  if (motion.kind == Motion::Kind::ConstantVelocity || motion.path.empty()) return T(constant * t_s);
+  T d = zero;
   double t_prev = 0.0;
-  Vec2 v_prev = motion_velocity_m_s(motion, 0.0);
+  T v_prev = knot_interpolate(motion, 0.0, constant, get);
   for (const auto& knot : motion.path) {
     if (knot.t_s <= t_prev) continue;
     const double t_next = std::min(knot.t_s, t_s);
-    const Vec2 v_next = motion_velocity_m_s(motion, t_next);
+    const T v_next = knot_interpolate(motion, t_next, constant, get);
     d += 0.5 * (v_prev + v_next) * (t_next - t_prev);
     t_prev = t_next;
     v_prev = v_next;
     if (t_prev >= t_s) return d;
   }
-  return d + motion.path.back().velocity_m_s * (t_s - t_prev);
+  return T(d + get(motion.path.back()) * (t_s - t_prev));
+}
+
+Vec2 knot_velocity(const Motion::Knot& k) { return k.velocity_m_s; }
+double knot_omega(const Motion::Knot& k) { return k.angular_velocity_rad_s; }
+
+}  // namespace
+
+Vec2 motion_velocity_m_s(const Motion& motion, double t_s) {
+  return knot_interpolate(motion, t_s, motion.velocity_m_s, knot_velocity);
+}
+
+Vec2 motion_displacement_m(const Motion& motion, double t_s) {
+  return knot_integral(motion, t_s, motion.velocity_m_s, Vec2(Vec2::Zero()), knot_velocity);
+}
+
+double motion_angular_velocity_rad_s(const Motion& motion, double t_s) {
+  return knot_interpolate(motion, t_s, motion.angular_velocity_rad_s, knot_omega);
+}
+
+double motion_rotation_rad(const Motion& motion, double t_s) {
+  return knot_integral(motion, t_s, motion.angular_velocity_rad_s, 0.0, knot_omega);
+}
+
+bool Body::rotates() const {
+  if (start_angle_rad != 0.0 || dynamics.free_angle || motion.angular_velocity_rad_s != 0.0) return true;
+  for (const auto& k : motion.path)
+    if (k.angular_velocity_rad_s != 0.0) return true;
+  return false;
+}
+
+double motion_max_angular_speed_rad_s(const Motion& motion) {
+  double w = std::abs(motion.angular_velocity_rad_s);
+  for (const auto& k : motion.path) w = std::max(w, std::abs(k.angular_velocity_rad_s));
+  return w;
 }
 
 double motion_max_speed_m_s(const Motion& motion) {

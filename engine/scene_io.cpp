@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "engine/bodies.hpp"
 #include "engine/fields.hpp"
 #include "engine/scene_detail.hpp"
 
@@ -388,6 +389,7 @@ Motion read_motion(const Ctx& c, const json& j, const std::string& path) {
   m.kind = Motion::Kind(choice(o, "type", kMotionTypes));
   if (m.kind == Motion::Kind::ConstantVelocity) {
     m.velocity_m_s = vec2(o, "velocity_m_s", kAny, "m/s");
+    m.angular_velocity_rad_s = num(o, "angular_velocity_rad_s", kAny, "rad/s, counter-clockwise", 0.0);
   } else {
     const json& ks = array(o, "knots", "{\"t_s\", \"velocity_m_s\"} knots", true, 1);
     for (size_t i = 0; i < ks.size(); ++i) {
@@ -401,13 +403,61 @@ Motion read_motion(const Ctx& c, const json& j, const std::string& path) {
         knot.t_s = num(k, "t_s", Range{prev, kInf, true, false}, "s", std::nullopt, " (knot times increase)");
       }
       knot.velocity_m_s = vec2(k, "velocity_m_s", kAny, "m/s");
+      knot.angular_velocity_rad_s = num(k, "angular_velocity_rad_s", kAny, "rad/s, counter-clockwise", 0.0);
       k.finish();
       m.path.push_back(knot);
     }
     m.velocity_m_s = m.path.front().velocity_m_s;
+    m.angular_velocity_rad_s = m.path.front().angular_velocity_rad_s;
   }
   o.finish();
   return m;
+}
+
+// "free": the degrees of freedom that respond to the media, with what they need: a mass (or a
+// density, times the shape's area) and, for the angle, a moment of inertia (the shape's own unless
+// given).
+BodyDynamics read_dynamics(Obj& o, const Shape& shape) {
+  const Ctx& c = o.ctx();
+  BodyDynamics d;
+  const json& free = array(o, "free", "degrees of freedom, each \"x\", \"y\" or \"angle\"", false, 0);
+  for (size_t i = 0; i < free.size(); ++i) {
+    const std::string p = o.at("free") + "/" + std::to_string(i);
+    const std::string dof = as_string(c, free[i], p, "\"x\", \"y\" or \"angle\"");
+    bool* flag = dof == "x" ? &d.free_x : dof == "y" ? &d.free_y : dof == "angle" ? &d.free_angle : nullptr;
+    if (!flag) fail(c, p, free[i], "\"x\", \"y\" or \"angle\"");
+    if (*flag) fail(c, p, free[i], "each degree of freedom listed once");
+    *flag = true;
+  }
+  const json* mass = o.opt("mass_kg_per_m");
+  const json* density = o.opt("density_kg_m3");
+  const json* inertia = o.opt("inertia_kg_m");
+  const json* force = o.opt("applied_force_N_per_m");
+  const json* torque = o.opt("applied_torque_N");
+  if (!d.any_free()) {
+    // a prescribed body has no use for them: say so rather than ignore them
+    for (const auto& [key, v] : {std::pair{"mass_kg_per_m", mass}, {"density_kg_m3", density}, {"inertia_kg_m", inertia},
+                                 {"applied_force_N_per_m", force}, {"applied_torque_N", torque}})
+      if (v) fail(c, o.at(key), *v, "no \"" + std::string(key) + "\" on a body whose motion is all prescribed (list the degrees of freedom that respond in \"free\")");
+    return d;
+  }
+  if (mass && density) fail(c, o.at("density_kg_m3"), *density, "either \"mass_kg_per_m\" or \"density_kg_m3\", not both");
+  if (!mass && !density)
+    fail(c, o.at("mass_kg_per_m"), "(missing)", "a positive mass (kg per metre) or \"density_kg_m3\": the body has free degrees of freedom");
+  const ShapeMass sm = shape_mass_properties(shape);
+  if (mass) {
+    d.mass_kg_per_m = as_number(c, *mass, o.at("mass_kg_per_m"), kPositive, "kg per metre");
+  } else {
+    d.mass_kg_per_m = as_number(c, *density, o.at("density_kg_m3"), kPositive, "kg/m^3") * sm.area_m2;
+  }
+  if (inertia) {
+    d.inertia_kg_m = as_number(c, *inertia, o.at("inertia_kg_m"), kPositive, "kg m^2 per metre, about the body's origin");
+  } else {
+    d.inertia_kg_m = d.mass_kg_per_m * sm.second_moment_m4 / sm.area_m2;  // a uniform body
+  }
+  if (force) d.applied_force_N_per_m = as_vec2(c, *force, o.at("applied_force_N_per_m"), kAny, "N per metre");
+  if (torque) d.applied_torque_N = as_number(c, *torque, o.at("applied_torque_N"), kAny, "N m per metre, counter-clockwise");
+  return d;
 }
 
 Body read_body(const Ctx& c, const json& j, const std::string& path) {
@@ -417,7 +467,9 @@ Body read_body(const Ctx& c, const json& j, const std::string& path) {
   b.shape = read_shape(c, o.req("shape", "a shape object {\"type\": " + one_of(kShapeTypes) + ", ...}"),
                        o.at("shape"), false, 0);
   b.start_m = vec2(o, "start_m", kAny, "m");
+  b.start_angle_rad = num(o, "start_angle_deg", closed(-360.0, 360.0), "degrees, counter-clockwise", 0.0) * M_PI / 180.0;
   if (const json* mv = o.opt("motion")) b.motion = read_motion(c, *mv, o.at("motion"));
+  b.dynamics = read_dynamics(o, b.shape);
   b.friction = num(o, "friction", kFriction, "", 0.35);
   o.finish();
   return b;
@@ -630,6 +682,25 @@ std::string wall_problem(const Scene& s, const Vec2& lo, const Vec2& hi) {
   return "";
 }
 
+// Bounds of a body about its origin for the whole run: one that turns may point any way, so its
+// reach in every direction; one that does not, its outline at the start angle.
+std::pair<Vec2, Vec2> body_run_bounds_m(const Body& b) {
+  if (!b.rotates()) return shape_bounds_m(b.shape);
+  const bool turns = b.dynamics.free_angle || motion_max_angular_speed_rad_s(b.motion) > 0.0;
+  const double ca = std::cos(b.start_angle_rad), sa = std::sin(b.start_angle_rad);
+  Vec2 lo = Vec2::Constant(kInf), hi = -lo;
+  double reach = 0.0;
+  for (const auto& loop : shape_outline(b.shape, 64))
+    for (const Vec2& p : loop) {
+      reach = std::max(reach, p.norm());
+      const Vec2 w(ca * p.x() - sa * p.y(), sa * p.x() + ca * p.y());
+      lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
+    }
+  const double pad = 0.002 * std::max(reach, (hi - lo).maxCoeff());  // a 64-gon lies inside its circle
+  if (turns) return {Vec2::Constant(-reach - pad), Vec2::Constant(reach + pad)};
+  return {lo - Vec2::Constant(pad), hi + Vec2::Constant(pad)};
+}
+
 void check_scene(const Ctx& c, const Scene& s) {
   const double W = s.domain.width_m, H = s.domain.height_m, dx = s.domain.dx_m;
   const double tol = 1e-9 * std::max(W, H);
@@ -691,10 +762,15 @@ void check_scene(const Ctx& c, const Scene& s) {
     if (dx > feature)
       fail(c, where, "a feature " + num_str(feature) + " m across",
            "a body at least one cell across (domain.dx_m = " + num_str(dx) + " m); use a smaller dx_m");
-    const auto [lo, hi] = shape_bounds_m(b.shape);
+    const auto [lo, hi] = body_run_bounds_m(b);
+    const std::string turning = b.rotates() && b.start_angle_rad == 0.0 ? " (turning, it reaches " + approx(hi.x()) + " m from its origin every way)" : "";
     if (std::string why = wall_problem(s, b.start_m + lo, b.start_m + hi); !why.empty())
-      fail(c, idx_path("bodies", i, "start_m"), vec_str(b.start_m), "a start that keeps the body inside the domain; " + why);
-    if (motion_max_speed_m_s(b.motion) == 0.0) continue;
+      fail(c, idx_path("bodies", i, "start_m"), vec_str(b.start_m), "a start that keeps the body inside the domain" + turning + "; " + why);
+    if (b.dynamics.any_free() && s.solver.contact == ContactMethod::Particle)
+      fail(c, idx_path("bodies", i, "free"), "free degrees of freedom with solver.contact \"particle\"",
+           "\"node\" or \"cell_fraction\" contact: a body responds through the grid's contact impulse");
+    // a free body goes where the media let it: the run stops with an error if it leaves the domain
+    if (motion_max_speed_m_s(b.motion) == 0.0 || b.dynamics.any_free()) continue;
     // sample the run (exact at knots and at the end; position is piecewise quadratic between)
     std::vector<double> times;
     for (int k = 1; k <= 256; ++k) times.push_back(t_end * k / 256.0);

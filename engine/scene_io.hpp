@@ -99,8 +99,12 @@ double contact_size_bias(ContactMethod method, double cells_across);
 Vec2 motion_velocity_m_s(const Motion& motion, double t_s);
 // Displacement from the start position after t_s (exact for piecewise-linear velocity).
 Vec2 motion_displacement_m(const Motion& motion, double t_s);
+// Angular velocity (counter-clockwise) and the angle turned since the start, likewise.
+double motion_angular_velocity_rad_s(const Motion& motion, double t_s);
+double motion_rotation_rad(const Motion& motion, double t_s);
 // Largest speed the motion ever has.
 double motion_max_speed_m_s(const Motion& motion);
+double motion_max_angular_speed_rad_s(const Motion& motion);
 // Index of the body whose straight-line distance from its start ends the run when
 // solver.end_displacement_m > 0: the first body in `bodies` that moves. -1 when none moves.
 int reference_body_index(const Scene& scene);

@@ -104,14 +104,15 @@ const KeyList kMaterialNdpmKeys = {"name", "model", "grain_density_kg_m3", "phi_
 const KeyList kMaterialDpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c", "mu_c", "chi",
                                   "phi_min", "youngs_modulus_Pa", "poisson_ratio", "mu_2", "I0", "grain_diameter_m"};
 const KeyList kBedKeys = {"material", "min_m", "max_m", "packing_fraction", "k0", "geostatic"};
-const KeyList kBodyKeys = {"name", "shape", "start_m", "motion", "friction"};
+const KeyList kBodyKeys = {"name", "shape", "start_m", "start_angle_deg", "motion", "free", "mass_kg_per_m", "density_kg_m3",
+                           "inertia_kg_m", "applied_force_N_per_m", "applied_torque_N", "friction"};
 const KeyList kBoxKeys = {"type", "size_m"};
 const KeyList kCircleKeys = {"type", "radius_m"};
 const KeyList kPolygonKeys = {"type", "vertices_m"};
 const KeyList kUnionKeys = {"type", "parts"};
-const KeyList kConstantMotionKeys = {"type", "velocity_m_s"};
+const KeyList kConstantMotionKeys = {"type", "velocity_m_s", "angular_velocity_rad_s"};
 const KeyList kPathMotionKeys = {"type", "knots"};
-const KeyList kKnotKeys = {"t_s", "velocity_m_s"};
+const KeyList kKnotKeys = {"t_s", "velocity_m_s", "angular_velocity_rad_s"};
 const KeyList kWallsKeys = {"left", "right", "bottom", "top", "front_back"};
 const KeyList kFrontBackKeys = {"gap_m", "friction"};
 const KeyList kFrictionWallKeys = {"type", "friction"};

@@ -1,5 +1,6 @@
 // Scene -> resolved JSON (every key written) and its pretty text in schema order.
 #include <algorithm>
+#include <cmath>
 
 #include "engine/scene_detail.hpp"
 
@@ -103,20 +104,36 @@ J to_json(const Scene& s) {
     bj["name"] = b.name;
     bj["shape"] = shape_json<J>(b.shape, false);
     bj["start_m"] = vec_json<J>(b.start_m);
+    // rotation and dynamics keys only when used: a body that neither turns nor responds keeps the
+    // resolved scene (and its hash) it had before bodies could
+    if (b.start_angle_rad != 0.0) bj["start_angle_deg"] = b.start_angle_rad * 180.0 / M_PI;
     J mj = J::object();
     mj["type"] = kMotionTypes[size_t(b.motion.kind)];
     if (b.motion.kind == Motion::Kind::ConstantVelocity) {
       mj["velocity_m_s"] = vec_json<J>(b.motion.velocity_m_s);
+      if (b.motion.angular_velocity_rad_s != 0.0) mj["angular_velocity_rad_s"] = b.motion.angular_velocity_rad_s;
     } else {
       mj["knots"] = J::array();
       for (const auto& k : b.motion.path) {
         J kj = J::object();
         kj["t_s"] = k.t_s;
         kj["velocity_m_s"] = vec_json<J>(k.velocity_m_s);
+        if (k.angular_velocity_rad_s != 0.0) kj["angular_velocity_rad_s"] = k.angular_velocity_rad_s;
         mj["knots"].push_back(kj);
       }
     }
     bj["motion"] = mj;
+    if (const BodyDynamics& d = b.dynamics; d.any_free()) {
+      J free = J::array();
+      if (d.free_x) free.push_back("x");
+      if (d.free_y) free.push_back("y");
+      if (d.free_angle) free.push_back("angle");
+      bj["free"] = free;
+      bj["mass_kg_per_m"] = d.mass_kg_per_m;
+      bj["inertia_kg_m"] = d.inertia_kg_m;
+      bj["applied_force_N_per_m"] = vec_json<J>(d.applied_force_N_per_m);
+      bj["applied_torque_N"] = d.applied_torque_N;
+    }
     bj["friction"] = b.friction;
     j["bodies"].push_back(bj);
   }

@@ -1,5 +1,6 @@
 #include "engine/simulation.hpp"
 
+#include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -11,6 +12,7 @@
 #include <cstddef>
 #include <cstring>
 #include <istream>
+#include <limits>
 #include <ostream>
 #include <numeric>
 #include <stdexcept>
@@ -212,8 +214,17 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     BodyState s;
     s.position_m = b.start_m;
     s.velocity_m_s = motion_velocity_m_s(b.motion, 0.0);
+    s.omega_rad_s = motion_angular_velocity_rad_s(b.motion, 0.0);
+    s.turns = b.rotates();
     std::tie(s.lo_m, s.hi_m) = shape_bounds_m(b.shape);
     bodies_.push_back(s);
+    if (b.dynamics.any_free() && scene_.solver.contact == ContactMethod::Particle)
+      throw std::invalid_argument("body '" + b.name + "': free degrees of freedom need node or cell_fraction contact");
+    // the outline's corners, for the bounds at any angle (circles: 64-gon, padded by its sagitta)
+    std::vector<Vec2> corners;
+    for (const auto& loop : shape_outline(b.shape, 64)) corners.insert(corners.end(), loop.begin(), loop.end());
+    body_corners_m_.push_back(std::move(corners));
+    set_body_angle(bodies_.size() - 1, b.start_angle_rad);
   }
   // plastic strain and its rate are kept only when a stored field or the stored points need them
   for (const auto& f : scene_.outputs.fields) track_plastic_ |= f == "strain_rate" || f == "plastic_strain";
@@ -282,7 +293,7 @@ void Simulation::seed_beds() {
         if (x < bed.min_m.x() || x >= bed.max_m.x()) continue;
         bool inside_body = false;
         for (size_t b = 0; b < scene_.bodies.size() && !inside_body; ++b)
-          inside_body = shape_sdf(scene_.bodies[b].shape, Vec2(x, y) - bodies_[b].position_m) < 0.0;
+          inside_body = shape_sdf(scene_.bodies[b].shape, bodies_[b].to_body(Vec2(x, y))) < 0.0;
         if (inside_body) continue;
         // geostatic stress: vertical rho g depth, horizontal and out-of-plane k0 times it
         const double sv = bed.geostatic ? mp.rho_g * phi_i * g * (bed.max_m.y() - y) : 0.0;
@@ -318,7 +329,10 @@ void Simulation::seed_beds() {
 
 double Simulation::next_dt_s() const {
   double vmax = stats_.max_speed_m_s;
-  for (const auto& b : bodies_) vmax = std::max(vmax, b.velocity_m_s.norm());
+  for (const auto& b : bodies_) {
+    const double reach = std::max(b.lo_m.cwiseAbs().maxCoeff(), b.hi_m.cwiseAbs().maxCoeff());
+    vmax = std::max(vmax, b.velocity_m_s.norm() + (b.turns ? std::abs(b.omega_rad_s) * std::sqrt(2.0) * reach : 0.0));
+  }
   for (size_t b = 0; b < bodies_.size(); ++b)
     vmax = std::max(vmax, motion_velocity_m_s(scene_.bodies[b].motion, t_s_).norm());
   return scene_.solver.cfl * g_.dx / (wave_speed_ + vmax);
@@ -333,11 +347,11 @@ void Simulation::sample_body_fields() {
   for (size_t p = 0; p < p_.size(); ++p) mass += p_.mass[p], volume += p_.volume[p];
   const double density = volume > 0.0 ? kBodyDensityRatio * mass / volume : 0.0;
   for (size_t b = 0; b < bodies_.size(); ++b) {
-    const BodyState& s = bodies_[b];
+    const auto [frame_lo, frame_hi] = shape_bounds_m(scene_.bodies[b].shape);  // in the body's frame
     std::vector<std::pair<Vec2, double>> inside;  // point, depth below the surface (m)
     double deepest = 0.0;
-    for (double y = s.lo_m.y() + 0.5 * h; y < s.hi_m.y(); y += h)
-      for (double x = s.lo_m.x() + 0.5 * h; x < s.hi_m.x(); x += h) {
+    for (double y = frame_lo.y() + 0.5 * h; y < frame_hi.y(); y += h)
+      for (double x = frame_lo.x() + 0.5 * h; x < frame_hi.x(); x += h) {
         const double depth = -shape_sdf(scene_.bodies[b].shape, Vec2(x, y));
         if (depth <= 0.0) continue;
         inside.emplace_back(Vec2(x, y), depth);
@@ -346,10 +360,12 @@ void Simulation::sample_body_fields() {
     const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
     const Shape& shape = scene_.bodies[b].shape;
     // across the body's travel (a path that turns keeps the direction of its middle)
-    const Vec2 travel = travel_direction(scene_, scene_.bodies[b]), across(-travel.y(), travel.x());
+    // (none for a body that turns: no one direction is across its travel)
+    const Vec2 travel = scene_.bodies[b].rotates() ? Vec2(0.0, 0.0) : travel_direction(scene_, scene_.bodies[b]);
+    const Vec2 across(-travel.y(), travel.x());
     // distance from q to the surface along +-across (bisection on the SDF; the body is inside its box)
     auto depth_across = [&](const Vec2& q) {
-      const double far = (s.hi_m - s.lo_m).norm();
+      const double far = (frame_hi - frame_lo).norm();
       double depth = far;
       for (double sign : {-1.0, 1.0}) {
         double in = 0.0, out = far;
@@ -689,11 +705,12 @@ inline bool contact(Vec2& v, const Vec2& vb, const Vec2& n, double mu) {
 // here, in one step and one point at a time, put single-step ticks of up to 13% on the force each
 // time a point first reached a face (tests/README.md, 2026-12-04). Whether it acted.
 inline bool put_back_on_surface(const BodyState& s, const Shape& shape, double dx, Vec2& x) {
-  const Vec2 q = x - s.position_m;
-  if (q.x() < s.lo_m.x() || q.y() < s.lo_m.y() || q.x() > s.hi_m.x() || q.y() > s.hi_m.y()) return false;
+  const Vec2 r = x - s.position_m;
+  if (r.x() < s.lo_m.x() || r.y() < s.lo_m.y() || r.x() > s.hi_m.x() || r.y() > s.hi_m.y()) return false;
+  const Vec2 q = s.to_body(x);
   const double d = shape_sdf(shape, q);
   if (d >= 0.0) return false;
-  x -= d * shape_normal(shape, q, 1e-4 * dx);
+  x -= d * s.to_world(shape_normal(shape, q, 1e-4 * dx));
   return true;
 }
 
@@ -723,17 +740,22 @@ void Simulation::bodies_and_walls() {
 template <bool Fraction>
 void Simulation::contact_nodes() {
   const double dt = dt_s_, dx = g_.dx;
+  held_.resize(bodies_.size());
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const Body& body = scene_.bodies[b];
     BodyState& s = bodies_[b];
     const double mu = scene_.effects.body_friction ? body.friction : 0.0;
     const auto [i0, i1, j0, j1] = body_node_box(s, g_);
     Vec2 impulse(0.0, 0.0);
+    double angular = 0.0;  // angular momentum the media gained about the body's origin
+    const bool free = body.dynamics.any_free();
+    // a free body: what each node's correction depends on the body's velocity (its projector)
+    if (free) held_[b].assign(size_t(i1 - i0 + 1) * size_t(j1 - j0 + 1), Vec3(0.0, 0.0, 0.0));
     for (int j = j0; j <= j1; ++j)
       for (int i = i0; i <= i1; ++i) {
         const size_t k = g_.index(i, j);
         GridNode& n = g_.node[k];
-        const Vec2 q = Vec2(i * dx, j * dx) - s.position_m;
+        const Vec2 xn(i * dx, j * dx), q = s.to_body(xn);
         double share = 1.0;
         const size_t c = size_t(j - j0) * size_t(i1 - i0 + 1) + size_t(i - i0);  // index in the body's box
         if constexpr (Fraction) {
@@ -756,14 +778,22 @@ void Simulation::contact_nodes() {
           const double m_points = stencil_mass_kg_[b][c];
           if (m_points <= 0.0) continue;
           v += share * (stencil_dv_kg_m_s_[b][c] / m_points);
-        } else if (!contact(v, s.velocity_m_s, shape_normal(body.shape, q, 1e-4 * dx), mu)) {
-          continue;
+        } else {
+          const Vec2 normal = s.to_world(shape_normal(body.shape, q, 1e-4 * dx));
+          if (!contact(v, s.velocity_at(xn), normal, mu)) continue;
+          if (free) held_[b][c] = Vec3(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
         }
-        impulse += n.m * (v - before);
+        if constexpr (Fraction)
+          if (free) held_[b][c] = share * stencil_nn_[b][c] / stencil_mass_kg_[b][c];
+        const Vec2 dp = n.m * (v - before);
+        impulse += dp;
+        if (s.turns || free) angular += (xn - s.position_m).x() * dp.y() - (xn - s.position_m).y() * dp.x();
         n.vx = v.x();
         n.vy = v.y();
       }
+    if (free) respond_free_body(b, impulse, angular);
     s.force_N_per_m = -impulse / dt;
+    s.torque_N = -angular / dt;
   }
 }
 
@@ -781,6 +811,7 @@ void Simulation::contact_cell_fraction() {
   body_node_mass_kg_.resize(bodies_.size());
   stencil_dv_kg_m_s_.resize(bodies_.size());
   stencil_mass_kg_.resize(bodies_.size());
+  stencil_nn_.resize(bodies_.size());
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const BodyState& s = bodies_[b];
     const Shape& shape = scene_.bodies[b].shape;
@@ -794,11 +825,13 @@ void Simulation::contact_cell_fraction() {
     auto& m_points = stencil_mass_kg_[b];
     dv.assign(box_nodes, Vec2(0.0, 0.0));
     m_points.assign(box_nodes, 0.0);
+    const bool free = scene_.bodies[b].dynamics.any_free();
+    if (free) stencil_nn_[b].assign(box_nodes, Vec3(0.0, 0.0, 0.0));
     // the body's field over its node box
     auto& field = body_node_mass_kg_[b];
     field.assign(box_nodes, 0.0);
     for (const Vec2& q : body_samples_m_[b]) {
-      const Vec2 x = s.position_m + q;
+      const Vec2 x = s.position_m + s.to_world(q);
       double wx[K::N], wy[K::N], dw[K::N];
       const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
       const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
@@ -812,10 +845,11 @@ void Simulation::contact_cell_fraction() {
     // nodes the body's field reaches: contact_nodes() acts on no other (and clears their marks).
     const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
     for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
-      const Vec2 q = Vec2(p_.x[p], p_.y[p]) - s.position_m;
-      if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
-          q.y() > s.hi_m.y() + reach)
+      const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
+      if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
+          r.y() > s.hi_m.y() + reach)
         continue;
+      const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
       double wx[K::N], wy[K::N], dw[K::N];
       const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
       const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
@@ -826,7 +860,8 @@ void Simulation::contact_cell_fraction() {
         for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
       if (!reached) continue;
       const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
-      const Vec2 normal = shape_normal(shape, q, 1e-4 * dx);
+      const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
+      const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
       const double mass = double(p_.mass[p]);
       for (int j = ja; j <= jb; ++j)
         for (int i = ia; i <= ib; ++i) {
@@ -837,7 +872,9 @@ void Simulation::contact_cell_fraction() {
           m_points[c] += wm;
           Vec2 v(g_.node[k].vx, g_.node[k].vy);
           const Vec2 v0 = v;
-          if (contact(v, s.velocity_m_s, normal, mu)) dv[c] += wm * (v - v0);
+          if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
+          dv[c] += wm * (v - v0);
+          if (free) stencil_nn_[b][c] += wm * nn;
         }
     }
   }
@@ -908,7 +945,7 @@ void Simulation::find_contact_points() {
     const uint32_t p = cand[2 * k], b = cand[2 * k + 1];
     const BodyState& s = bodies_[b];
     const Shape& shape = scene_.bodies[b].shape;
-    const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
+    const Vec2 q = s.to_body(Vec2(P.x[p], P.y[p]));
     const double half = 0.5 * std::sqrt(P.volume[p]);
     const double gap = shape_sdf(shape, q) - half;
     if (gap > dx) return;
@@ -928,8 +965,8 @@ void Simulation::find_contact_points() {
         if (m > 0.0) sum += w * w / m;
       }
     c.inv_meff = sum;
-    c.n = shape_normal(shape, q, 1e-4 * dx);
-    c.vb = s.velocity_m_s;
+    c.n = s.to_world(shape_normal(shape, q, 1e-4 * dx));
+    c.vb = s.velocity_at(Vec2(P.x[p], P.y[p]));
     c.gap_m = gap;
     c.mu = friction ? scene_.bodies[b].friction : 0.0;
     c.jn = c.jt = 0.0;
@@ -1022,8 +1059,16 @@ void Simulation::solve_contact_points() {
     if (residual <= tol) break;
   }
   std::vector<Vec2> impulse(nb, Vec2(0.0, 0.0));
-  for (const ContactPoint& c : contacts_) impulse[c.body] += c.impulse();
-  for (size_t b = 0; b < nb; ++b) bodies_[b].force_N_per_m = -impulse[b] / dt;
+  std::vector<double> angular(nb, 0.0);
+  for (const ContactPoint& c : contacts_) {
+    impulse[c.body] += c.impulse();
+    const Vec2 r = Vec2(p_.x[c.particle], p_.y[c.particle]) - bodies_[c.body].position_m, J = c.impulse();
+    angular[c.body] += r.x() * J.y() - r.y() * J.x();
+  }
+  for (size_t b = 0; b < nb; ++b) {
+    bodies_[b].force_N_per_m = -impulse[b] / dt;
+    bodies_[b].torque_N = -angular[b] / dt;
+  }
   stats_.contact_points = int64_t(contacts_.size());
   stats_.contact_sweeps = std::min(sweep + 1, kMaxSweeps);
   stats_.contact_residual_m_s = residual;
@@ -1476,13 +1521,127 @@ void Simulation::particles_update(bool g2p, bool constitutive) {
   stats_.max_speed_m_s = std::sqrt(vmax2);
 }
 
+// Prescribed degrees of freedom follow the motion; free ones move with the velocity the contact
+// left them (respond_free_body), and must stay inside the domain.
 void Simulation::advance_bodies() {
   const double t = t_s_ + dt_s_;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const Body& body = scene_.bodies[b];
-    bodies_[b].position_m = body.start_m + motion_displacement_m(body.motion, t);
-    bodies_[b].velocity_m_s = motion_velocity_m_s(body.motion, t);
+    const BodyDynamics& d = body.dynamics;
+    BodyState& s = bodies_[b];
+    if (!d.any_free()) {
+      s.position_m = body.start_m + motion_displacement_m(body.motion, t);
+      s.velocity_m_s = motion_velocity_m_s(body.motion, t);
+    } else {
+      const Vec2 at = body.start_m + motion_displacement_m(body.motion, t), v = motion_velocity_m_s(body.motion, t);
+      s.position_m.x() = d.free_x ? s.position_m.x() + dt_s_ * s.velocity_m_s.x() : at.x();
+      s.position_m.y() = d.free_y ? s.position_m.y() + dt_s_ * s.velocity_m_s.y() : at.y();
+      if (!d.free_x) s.velocity_m_s.x() = v.x();
+      if (!d.free_y) s.velocity_m_s.y() = v.y();
+    }
+    if (!s.turns) continue;
+    if (d.free_angle) {
+      set_body_angle(b, s.angle_rad + dt_s_ * s.omega_rad_s);
+    } else {
+      set_body_angle(b, body.start_angle_rad + motion_rotation_rad(body.motion, t));
+      s.omega_rad_s = motion_angular_velocity_rad_s(body.motion, t);
+    }
   }
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    if (!scene_.bodies[b].dynamics.any_free()) continue;
+    const BodyState& s = bodies_[b];
+    const Vec2 lo = s.position_m + s.lo_m, hi = s.position_m + s.hi_m;
+    const auto& dom = scene_.domain;
+    if (!(lo.x() >= 0.0 && lo.y() >= 0.0 && hi.x() <= dom.width_m && hi.y() <= dom.height_m))
+      throw std::runtime_error("body '" + scene_.bodies[b].name + "' left the domain at t = " + std::to_string(t) +
+                               " s (its box [" + std::to_string(lo.x()) + ", " + std::to_string(lo.y()) + "] to [" +
+                               std::to_string(hi.x()) + ", " + std::to_string(hi.y()) + "] m)");
+  }
+}
+
+void Simulation::set_body_angle(size_t b, double angle_rad) {
+  BodyState& s = bodies_[b];
+  s.angle_rad = angle_rad;
+  if (!s.turns) return;
+  s.cos_a = std::cos(angle_rad);
+  s.sin_a = std::sin(angle_rad);
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::max()), hi = -lo;
+  for (const Vec2& c : body_corners_m_[b]) {
+    const Vec2 w = s.to_world(c);
+    lo = lo.cwiseMin(w);
+    hi = hi.cwiseMax(w);
+  }
+  // a 64-gon's sides lie inside its circle by at most 0.12% of the radius
+  const double pad = 0.002 * (hi - lo).maxCoeff();
+  s.lo_m = lo - Vec2::Constant(pad);
+  s.hi_m = hi + Vec2::Constant(pad);
+}
+
+// Two-way coupling of a body's free degrees of freedom u = (vx, vy, omega). The contact has just
+// held each node against the body moving at u0 and given the media `impulse` (and `angular`, about
+// the body's origin). Had the body moved at u0 + du, each held node would have changed by a further
+// P G du (P its projector, G du the body's velocity change at the node), the media gaining K du
+// with K = sum m G^T P G. The body's equation, M du = -impulse + dt F_applied + dt M g - K du, is
+// solved for du over the free degrees of freedom, and each node takes its P G du: the media gain
+// exactly what the body loses, so media + body change momentum only by gravity and the applied
+// loads, and a body light against the media it holds moves with them instead of overshooting
+// (K in the denominator), a heavy one barely responds (M).
+void Simulation::respond_free_body(size_t b, Vec2& impulse, double& angular) {
+  const BodyDynamics& d = scene_.bodies[b].dynamics;
+  BodyState& s = bodies_[b];
+  const double dt = dt_s_, dx = g_.dx;
+  const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+  const size_t width = size_t(i1 - i0 + 1);
+  const std::vector<Vec3>& held = held_[b];
+  auto jacobian = [](const Vec2& r) {  // body velocity change at r per du
+    Eigen::Matrix<double, 2, 3> G;
+    G << 1.0, 0.0, -r.y(), 0.0, 1.0, r.x();
+    return G;
+  };
+  auto projector = [](const Vec3& h) { return (Eigen::Matrix2d() << h.x(), h.y(), h.y(), h.z()).finished(); };
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const Vec3& h = held[size_t(j - j0) * width + size_t(i - i0)];
+      if (h.isZero()) continue;
+      const auto G = jacobian(Vec2(i * dx, j * dx) - s.position_m);
+      A += g_.node[g_.index(i, j)].m * (G.transpose() * projector(h) * G);
+    }
+  A(0, 0) += d.mass_kg_per_m;
+  A(1, 1) += d.mass_kg_per_m;
+  A(2, 2) += d.inertia_kg_m;
+  const Vec2 load = d.applied_force_N_per_m + d.mass_kg_per_m * gravity_;
+  const Vec3 rhs(dt * load.x() - impulse.x(), dt * load.y() - impulse.y(), dt * d.applied_torque_N - angular);
+  // the free degrees of freedom only: a prescribed one does not change here
+  const bool free[3] = {d.free_x, d.free_y, d.free_angle};
+  int index[3], nf = 0;
+  for (int k = 0; k < 3; ++k)
+    if (free[k]) index[nf++] = k;
+  Eigen::MatrixXd Af(nf, nf);
+  Eigen::VectorXd bf(nf);
+  for (int a = 0; a < nf; ++a) {
+    bf[a] = rhs[index[a]];
+    for (int c = 0; c < nf; ++c) Af(a, c) = A(index[a], index[c]);
+  }
+  const Eigen::VectorXd x = Af.ldlt().solve(bf);  // symmetric positive definite: mass > 0
+  Vec3 du(0.0, 0.0, 0.0);
+  for (int a = 0; a < nf; ++a) du[index[a]] = x[a];
+  // the held nodes follow the body's change
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const Vec3& h = held[size_t(j - j0) * width + size_t(i - i0)];
+      if (h.isZero()) continue;
+      const Vec2 r = Vec2(i * dx, j * dx) - s.position_m;
+      const Vec2 dv = projector(h) * (jacobian(r) * du);
+      GridNode& n = g_.node[g_.index(i, j)];
+      n.vx += dv.x();
+      n.vy += dv.y();
+      const Vec2 dp = n.m * dv;
+      impulse += dp;
+      angular += r.x() * dp.y() - r.y() * dp.x();
+    }
+  s.velocity_m_s += du.head<2>();
+  s.omega_rad_s += du.z();
 }
 
 // Physically reorder particle arrays by strip, then by stencil row and column within it, so P2G and
@@ -1563,7 +1722,7 @@ constexpr char kCheckpointMagic[8] = {'F', 'U', 'R', 'R', 'O', 'W', 'C', 'K'};
 // column-major node order; version 1 (row-major) is still read and renumbered.
 // 3: P2G's strip ranges (the points' home strips). Versions 1 and 2 are read and the points sorted
 // into strips again before the next step.
-constexpr uint32_t kCheckpointVersion = 3;
+constexpr uint32_t kCheckpointVersion = 4;  // 4: bodies carry an angle, angular velocity and torque
 
 template <class T> void put(std::ostream& out, const T& v) {
   static_assert(std::is_trivially_destructible_v<T> && !std::is_pointer_v<T>);  // plain values (Eigen's fixed-size too)
@@ -1644,7 +1803,19 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
   t_s_ = r.get<double>("time"), dt_s_ = r.get<double>("dt"), steps_ = r.get<int64_t>("steps");
   stats_ = r.get<StepStats>("step statistics"), phase_s_ = r.get<PhaseSeconds>("phase seconds");
   wall_forces_ = r.get<std::array<Vec2, 4>>("wall forces");
-  r.get_vector(bodies_, "bodies", bodies_.size());
+  if (version >= 4) {
+    r.get_vector(bodies_, "bodies", bodies_.size());
+  } else {
+    struct BodyStateV3 {
+      Vec2 position_m, velocity_m_s, force_N_per_m, lo_m, hi_m;
+    };
+    std::vector<BodyStateV3> old;
+    r.get_vector(old, "bodies", bodies_.size());
+    for (size_t b = 0; b < old.size(); ++b) {
+      bodies_[b].position_m = old[b].position_m, bodies_[b].velocity_m_s = old[b].velocity_m_s;
+      bodies_[b].force_N_per_m = old[b].force_N_per_m, bodies_[b].lo_m = old[b].lo_m, bodies_[b].hi_m = old[b].hi_m;
+    }
+  }
   const auto marks = r.get<uint64_t>("contact marks");
   if (marks > bodies_.size()) r.fail("contact marks", std::to_string(marks) + " bodies' marks");
   touched_.resize(size_t(marks));
@@ -1723,7 +1894,7 @@ std::vector<BodyOutline> Simulation::body_outlines() const {
     for (size_t k = 0; k < loops.size(); ++k) {
       BodyOutline o;
       o.name = scene_.bodies[b].name + (k ? "#" + std::to_string(k) : "");
-      for (const auto& v : loops[k]) o.outline_m.push_back(v + bodies_[b].position_m);
+      for (const auto& v : loops[k]) o.outline_m.push_back(bodies_[b].position_m + bodies_[b].to_world(v));
       o.position_m = bodies_[b].position_m;
       if (k == 0) o.force_N_per_m = bodies_[b].force_N_per_m;
       out.push_back(o);

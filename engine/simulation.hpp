@@ -96,7 +96,25 @@ struct BodyState {
   Vec2 position_m{0, 0};
   Vec2 velocity_m_s{0, 0};
   Vec2 force_N_per_m{0, 0};  // reaction of the media on the body in the last step
-  Vec2 lo_m{0, 0}, hi_m{0, 0};  // body-frame bounds
+  Vec2 lo_m{0, 0}, hi_m{0, 0};  // bounds of the body at its angle, world axes, about position_m
+  double angle_rad = 0.0, omega_rad_s = 0.0;  // counter-clockwise, about position_m
+  double torque_N = 0.0;  // N m per metre, of the media on the body about position_m, counter-clockwise
+  double cos_a = 1.0, sin_a = 0.0;  // of angle_rad
+  bool turns = false;  // the body may ever have an angle: contact then works in its frame
+  // a point x (world) in the body's frame, and a body-frame direction in world axes
+  Vec2 to_body(const Vec2& x) const {
+    const Vec2 r = x - position_m;
+    return turns ? Vec2(cos_a * r.x() + sin_a * r.y(), -sin_a * r.x() + cos_a * r.y()) : r;
+  }
+  Vec2 to_world(const Vec2& n) const {
+    return turns ? Vec2(cos_a * n.x() - sin_a * n.y(), sin_a * n.x() + cos_a * n.y()) : n;
+  }
+  // velocity of the body's material at x (world): v + omega z x r
+  Vec2 velocity_at(const Vec2& x) const {
+    return turns ? Vec2(velocity_m_s.x() - omega_rad_s * (x.y() - position_m.y()),
+                        velocity_m_s.y() + omega_rad_s * (x.x() - position_m.x()))
+                 : velocity_m_s;
+  }
 };
 
 struct StepStats {
@@ -221,6 +239,9 @@ class Simulation {
   template <bool Dilatancy, bool Track> size_t constitutive_by_four(size_t begin, size_t end);
   void particles_update(bool g2p, bool constitutive);
   void advance_bodies();
+  void set_body_angle(size_t b, double angle_rad);
+  // free bodies: the contact's linearisation in the body's velocity (contact_nodes)
+  void respond_free_body(size_t b, Vec2& impulse, double& angular);
   template <class Kernel> void reorder_particles();
   void set_home_strips();
 
@@ -262,6 +283,11 @@ class Simulation {
   // (body frame, m) and their mass (kg per metre); the field's nodal mass over the body's node box
   std::vector<std::vector<uint8_t>> touched_;
   std::vector<std::vector<Vec2>> body_samples_m_;
+  std::vector<std::vector<Vec2>> body_corners_m_;  // outline corners, body frame (bounds at any angle)
+  // free bodies, per node of the body's box: the part of the node's correction that follows the
+  // body's velocity (a symmetric 2x2 projector times the share: xx, xy, yy), and (cell_fraction)
+  // its stencil sums of mass x n n^T
+  std::vector<std::vector<Vec3>> held_, stencil_nn_;
   double body_sample_mass_kg_ = 0.0;
   double body_node_full_kg_ = 0.0;
   std::vector<std::vector<double>> body_node_mass_kg_;
