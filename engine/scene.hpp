@@ -134,6 +134,7 @@ struct Solver {
   // FLIP share of the particle velocity update (0 = pure APIC). APIC alone damps non-affine
   // motion once per step, a viscosity ~ dx^2/dt that grows as dt shrinks.
   double flip_blend = 0.99;
+  // Scenes built in code get Node; a scene file without solver.contact gets CellFraction (scene_io.cpp).
   ContactMethod contact = ContactMethod::Node;
   double end_time_s = 1.0;
   double end_displacement_m = -1.0;  // stop when the first moving body has travelled this far (> 0)
