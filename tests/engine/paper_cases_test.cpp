@@ -150,7 +150,7 @@ constexpr double kPlateV = 0.2, kPlateE = 1.25e6;
 
 // A bed of `width` x `depth` with plates of width L (thickness 2 dx) whose bottoms start half a cell
 // above the surface at the given centres, all moving down together. Cell-fraction contact, as the
-// plate_intrusion and two_plates templates use (node contact until 2026-12-02; README table).
+// plate_intrusion and two_plates templates use (node contact until 2026-12-02; engine/README.md, "Which template uses which").
 Scene plates_scene(double width_m, double depth_m, double dx_m, double L_m, const std::vector<double>& centres_m,
                    double travel_m, double E_Pa = kPlateE) {
   Scene s = bed(width_m, depth_m, 4.0 * dx_m, dx_m, 0.40);
