@@ -12,9 +12,10 @@ using Vec2 = Eigen::Vector2d;
 
 enum class ShapeFunction { Linear, Quadratic, Cubic };
 enum class MaterialModel { NDPM, DPM };
-// How bodies act on the media: on the grid nodes inside them (default; the force steps each time a
-// face crosses a node line), or on the material points touching their surface (smooth, but the
-// constraint spreads over the points' B-spline stencils: a body acts about a cell larger).
+// How bodies act on the media: on the grid nodes inside them (the force steps each time a face
+// crosses a node line), on the material points touching their surface (smooth, but the constraint
+// spreads over the points' B-spline stencils: a body acts about a cell larger), or as a mass field
+// sharing each node's correction (smooth; a scene file's default). engine/README.md compares them.
 enum class ContactMethod { Node, Particle, CellFraction };
 // The scene file's name of a contact method ("node", "particle", "cell_fraction").
 const char* contact_method_name(ContactMethod method);
