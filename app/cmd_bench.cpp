@@ -122,7 +122,7 @@ int bench_main(const Parsed& p) {
         std::fflush(stdout);
       }
   // the same at the paper's dx 1.25 mm (16 times the points, 1.84M): how the rate falls with the
-  // bed's size (at 4 times the points it had not fallen measurably; README, Performance)
+  // bed's size (at 4 times the points it had not fallen measurably; engine/README.md, Performance)
   {
     Simulation sim(bench_scene(ShapeFunction::Quadratic, false, thread_counts.back(), 0.00125));
     const double rate = measure_rate(sim, seconds, nullptr);

@@ -126,7 +126,7 @@ std::string scene_summary(const Scene& s, const std::string& source) {
       os << " (under 8 cells across: its force depends strongly on dx and the contact method)";
     else if (std::abs(bias) >= 0.01)
       os << " (a plate this many cells across reads ~" << fmt("%.0f", 100 * std::abs(bias)) << "% "
-         << (bias < 0 ? "low" : "high") << ": README \"Body contact\")";
+         << (bias < 0 ? "low" : "high") << ": engine/README.md, \"Body contact\")";
     os << "\n";
   }
   os << "  time step  ~" << fmt("%.3g", dt) << " s (cfl " << fmt("%g", s.solver.cfl) << ")\n";

@@ -3,7 +3,7 @@
 // field_registry(); nothing here keeps its own list of fields except the rasterizer's table of
 // which particle array feeds which field.
 //
-// Frame files (DESIGN §6, §7), one per frame: <run>/frames/frame_00042.vdb holding
+// Frame files (OpenVDB and ParaView), one per frame: <run>/frames/frame_00042.vdb holding
 //   - `velocity`: Vec3SGrid (vx, vy, 0);
 //   - one FloatGrid per scalar field, named as in the registry (pressure, strain_rate, ...);
 //   - `density`: when packing_fraction is stored and the bulk density field is not, a copy of

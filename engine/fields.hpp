@@ -24,7 +24,7 @@ const std::vector<FieldInfo>& field_registry();
 const FieldInfo* find_field(const std::string& name);
 
 // A read-only particle array stored as double or float (the solver stores some quantities as
-// float: README, Performance); reads give double.
+// float: engine/README.md, "Stored precision"); reads give double.
 class ScalarArray {
  public:
   ScalarArray() = default;

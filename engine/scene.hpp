@@ -13,9 +13,10 @@ using Vec3 = Eigen::Vector3d;
 
 enum class ShapeFunction { Linear, Quadratic, Cubic };
 enum class MaterialModel { NDPM, DPM };
-// How bodies act on the media: on the grid nodes inside them (default; the force steps each time a
-// face crosses a node line), or on the material points touching their surface (smooth, but the
-// constraint spreads over the points' B-spline stencils: a body acts about a cell larger).
+// How bodies act on the media: on the grid nodes inside them (the force steps each time a face
+// crosses a node line), on the material points touching their surface (smooth, but the constraint
+// spreads over the points' B-spline stencils: a body acts about a cell larger), or as a mass field
+// sharing each node's correction (smooth; a scene file's default). engine/README.md compares them.
 enum class ContactMethod { Node, Particle, CellFraction };
 // The scene file's name of a contact method ("node", "particle", "cell_fraction").
 const char* contact_method_name(ContactMethod method);
@@ -155,6 +156,7 @@ struct Solver {
   // FLIP share of the particle velocity update (0 = pure APIC). APIC alone damps non-affine
   // motion once per step, a viscosity ~ dx^2/dt that grows as dt shrinks.
   double flip_blend = 0.99;
+  // Scenes built in code get Node; a scene file without solver.contact gets CellFraction (scene_io.cpp).
   ContactMethod contact = ContactMethod::Node;
   double end_time_s = 1.0;
   double end_displacement_m = -1.0;  // stop when the first moving body has travelled this far (> 0)

@@ -92,7 +92,7 @@ Vec2 travel_direction(const Scene& scene, const Body& body);
 double body_cells_across(const Scene& scene, const Body& body);
 // How far a body's mean force at `cells_across` tends to sit from its converged value with each
 // contact method (relative, + = larger): ~ c / cells, c fitted to a plate at 8, 16 and 32 cells
-// (README, "Body contact"): node and cell_fraction act smaller, particle larger.
+// (engine/README.md, "Body contact"): node and cell_fraction act smaller, particle larger.
 double contact_size_bias(ContactMethod method, double cells_across);
 
 // ---- body kinematics (prescribed motion) ----

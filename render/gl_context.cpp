@@ -1,4 +1,4 @@
-// Headless OpenGL for Debian's X-only VTK 9.1 (DESIGN 7): OSMesa core context + GLX stand-ins that
+// Headless OpenGL for Debian's X-only VTK 9.1 (render/README.md): OSMesa core context + GLX stand-ins that
 // GLEW binds to + a generic VTK render window on the current context.
 #include "render/gl_context.hpp"
 

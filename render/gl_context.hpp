@@ -1,5 +1,5 @@
 // Off-screen OpenGL without a display: an OSMesa core-profile context on a buffer we own, and a
-// VTK render window that draws into it. All the Debian-specific workarounds (DESIGN 7) live in
+// VTK render window that draws into it. All the Debian-specific workarounds live in
 // gl_context.cpp and nowhere else.
 #pragma once
 #include <cstdint>

@@ -1,6 +1,6 @@
 // The inspector in a window on a display (GLFW + X11). Every image is the off-screen
 // InspectorView's (OSMesa + VTK + ImGui), shown with XPutImage: the window has no GL context,
-// because Mesa's OSMesa library, linked first for VTK (DESIGN 7), owns the process's gl* symbols.
+// because Mesa's OSMesa library, linked first for VTK, owns the process's gl* symbols.
 // Mouse and keys drive the same actions as a script:
 //   panel: field and frame pickers;  click on the field: probe there;
 //   Left/Right: previous/next frame;  W: wedge overlay on/off;  S: screenshot (inspect.png, inspect_2.png, ... in the current

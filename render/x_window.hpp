@@ -1,5 +1,5 @@
 // A GLFW window on an X11 display that shows off-screen images (the inspector's and the editor's):
-// no GL context on the window, because Mesa's OSMesa library, linked first for VTK (DESIGN 7), owns
+// no GL context on the window, because Mesa's OSMesa library, linked first for VTK, owns
 // the process's gl* symbols; pixels go through XPutImage. Include last: X11 defines None, Bool...
 #pragma once
 #if defined(FURROW_HAVE_GLFW) && defined(FURROW_HAVE_X11)

@@ -1,4 +1,4 @@
-// Field store costs (DESIGN §8: storing a frame of 10^5 cells in OpenVDB takes <= 50 ms).
+// Field store costs (target: storing a frame of 10^5 cells in OpenVDB takes <= 50 ms).
 // Frame: 400 x 250 cells, all holding material, with velocity, pressure, strain_rate and
 // packing_fraction (plus the free `density` alias); values are noisy so compression is not flattered.
 // "CPU" is the whole process (all threads), so it stays meaningful on a loaded machine.

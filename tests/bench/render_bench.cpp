@@ -1,7 +1,7 @@
 // Milliseconds per 1280x720 movie frame (render + read-back) for a 400 x 250 = 10^5-cell field
 // with colorbar, time stamp, title and a body outline; drawn blended at about the image's
 // resolution (the default), as flat cells (the baseline in the same run), and with the force panel.
-// DESIGN 8 target: <= 100 ms per frame.
+// Target: <= 100 ms per frame.
 #include <benchmark/benchmark.h>
 
 #include <cmath>

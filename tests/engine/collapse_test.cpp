@@ -24,7 +24,7 @@ Scene collapse_template(std::vector<std::string> sets) {
 }
 
 // The test resolution: dx 4 mm, a quarter of the template's cost per step and half its steps (the
-// template's 2 mm is where the runout has converged; 4 mm runs 5-7% shorter, README).
+// template's 2 mm is where the runout has converged; 4 mm runs 5-7% shorter, tests/README.md).
 const std::string kTestDx = "domain.dx_m=0.004";
 // A column twice as tall as wide in a domain that holds its runout. The fronts stop by 0.44 s
 // (a = 1) and 0.58 s (a = 2) at this dx; `settled` checks that the runs were long enough.
@@ -151,7 +151,7 @@ TEST(CollapseAnalysis, RunJsonHasTheRunoutSeries) {
 // et al. 2005), and grows linearly with a as they find for a up to about 2-3 (ratio 2; the a^(2/3)
 // regime beyond would give 1.59). mu(I) shortens it: the friction rises with the shear rate (at
 // I ~ 0.1 by ~0.07, 18% of mu_s). The side walls take 2 mu_w |sigma_zz| / W per unit volume; in
-// plane strain the same runs give 1.88 and 4.00, above the upper law (README).
+// plane strain the same runs give 1.88 and 4.00, above the upper law (tests/README.md).
 TEST(ColumnCollapse, RunoutIsLinearInAspectRatioAndMuIShortensIt) {
   std::vector<std::string> off = kOnce;
   off.push_back("effects.rate_dependence=false");

@@ -97,7 +97,7 @@ TEST(ContactSmoothness, LooseIntrusionHasNoSpikes) {
 // lines): 1.133x, RMS 1.61%, cell component 0.86% (node 1.46x, 8.9%, 7.8%); the same plate half a
 // cell off the node lines: 1.086x, 1.11%, 0.84%. Before the share reached 1 inside the body
 // (2026-12-02) the first was 1.151x: points riding the plate's leading face near its corners,
-// kicked into it by FLIP and put back by G2P's safety net (README, "Body contact"). The
+// kicked into it by FLIP and put back by G2P's safety net (engine/README.md, "Body contact"). The
 // mass-gradient normal this method used before met the peak (1.13x) but not the rest half a cell
 // sideways (2.15%, 2.0%); its first form, a ramp, met the first case (1.12x, 2.4%, 2.05%) but not
 // the second (1.09x, 5.3%, 5.9%), which is why the test runs both. loose_intrusion: 1.14x from

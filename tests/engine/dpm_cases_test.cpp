@@ -254,7 +254,7 @@ TEST(DpmPlowing, OverCompactedBedStaysFiniteInsideAndPhysical) {
 // at most that short wedge, so it is at most tan(31.0 deg) / tan(37.2 deg) = 0.79 of the late one
 // (both shortened alike by the 10% speed criterion); a zone that did not grow gives 1. Until
 // 2026-12-03 the bound was 0.6, set from `node`'s 0.54 with no physics behind it; `cell_fraction`
-// measured 0.606 and 0.661 at dx 2.5 mm, 0.550 and 0.546 at 2 mm (README, Body contact).
+// measured 0.606 and 0.661 at dx 2.5 mm, 0.550 and 0.546 at 2 mm (engine/README.md, "Body contact").
 TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
   const double dx = 0.002, bed_w = 0.25, bed_h = 0.16, gap = 0.002, v = 0.15, travel = 0.05;
   Scene s = bed_scene(dpm_material("poppy_seeds", 1100.0, 0.53, 5.0, 2.0e6), bed_w, bed_h, 0.03, dx, 10.0, 0.55);

@@ -19,7 +19,7 @@ namespace {
 // a node line (largest step 2.3x the one-cell mean, RMS 18%, at 6 cells per D and 15 D; cell
 // fraction 1.13x, 2.6%), and its 10 -> 15 D lift change moved from 0.09 to 0.47 to 0.28 of the
 // drag's at 4, 6, 8 cells per D. Cell fraction reads 0.78, 0.30, 0.35: at 4 cells its 10 D lift is
-// 23% low, so 6 is the coarsest at which it shows the lift levelling off (README, Body contact).
+// 23% low, so 6 is the coarsest at which it shows the lift levelling off (engine/README.md, "Body contact").
 //
 // Transfer: 10% APIC in the velocity update (flip_blend 0.9). With the default 0.99 the drag
 // saturates beyond |z| ~ 10 D at 4 and 8 cells per D alike (node contact: dx 1 mm 13 -> 12.5 N/m
@@ -150,7 +150,7 @@ constexpr double kPlateV = 0.2, kPlateE = 1.25e6;
 
 // A bed of `width` x `depth` with plates of width L (thickness 2 dx) whose bottoms start half a cell
 // above the surface at the given centres, all moving down together. Cell-fraction contact, as the
-// plate_intrusion and two_plates templates use (node contact until 2026-12-02; README table).
+// plate_intrusion and two_plates templates use (node contact until 2026-12-02; engine/README.md, "Which template uses which").
 Scene plates_scene(double width_m, double depth_m, double dx_m, double L_m, const std::vector<double>& centres_m,
                    double travel_m, double E_Pa = kPlateE) {
   Scene s = bed(width_m, depth_m, 4.0 * dx_m, dx_m, 0.40);

@@ -437,6 +437,26 @@ TEST(SceneReadme, DocumentsEveryKeyAndItsExampleValidates) {
   EXPECT_EQ(s.bodies[0].motion.path.size(), 2u);
 }
 
+// A hand-written scene file without solver.contact gets cell_fraction, not node's force comb;
+// the templates with bodies say which method they use, so the default moves none of them.
+TEST(SceneDefaults, SceneFileWithoutContactResolvesToCellFraction) {
+  const std::string readme = read_text(kSceneDir / "README.md");
+  const auto start = readme.rfind("```json\n"), end = readme.rfind("```");
+  ASSERT_NE(start, std::string::npos);
+  const std::string example = readme.substr(start + 8, end - start - 8);
+  ASSERT_FALSE(json::parse(example)["solver"].contains("contact"));
+  const Scene s = furrow::parse_scene_text(example, "README.md");
+  ASSERT_FALSE(s.bodies.empty());
+  EXPECT_EQ(s.solver.contact, furrow::ContactMethod::CellFraction);
+  EXPECT_EQ(furrow::scene_to_json(s)["solver"]["contact"], "cell_fraction");  // the resolved scene says so
+  EXPECT_EQ(furrow::parse_scene_text(example, "README.md", {"solver.contact=node"}).solver.contact,
+            furrow::ContactMethod::Node);
+  for (const auto& n : template_names()) {
+    const json t = template_json(n);
+    if (t.contains("bodies") && !t["bodies"].empty()) EXPECT_TRUE(t["solver"].contains("contact")) << n;
+  }
+}
+
 TEST(SceneErrors, LongListsAreAcceptedUpToTheLimit) {
   // a 1000-knot path (slow start, then steady 0.1 m/s down) and a 1000-vertex plate-like polygon
   json j = template_json("plate_intrusion");
