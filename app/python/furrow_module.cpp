@@ -6,6 +6,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -329,7 +330,8 @@ PYBIND11_MODULE(_furrow, m) {
       .def("bodies", [](const PySimulation& s) { return bodies_list(*s.sim); })
       .def("wall_forces", [](const PySimulation& s) {
         py::list out;
-        for (const auto& f : s.sim->wall_forces()) out.append(vec2(f));
+        // zero before the first step (the engine sets them in its first step)
+        for (const auto& f : s.sim->wall_forces()) out.append(vec2(s.sim->step_count() ? f : Vec2(0, 0)));
         return out;
       });
 

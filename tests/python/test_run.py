@@ -51,8 +51,10 @@ def test_frames_carry_their_grid(plate_runs, small_plate):
     assert x[0] == pytest.approx(f.origin_m[0] + f.dx_m / 2)
     # the bed fills y < 0.2 m: material in every cell below, none above
     assert f.active[y < 0.2].all() and not f.active[y > 0.2].any()
+    # a frame is written at the first step at or past each multiple of frame_interval_s
     times = run.frame_times_s()
-    np.testing.assert_allclose(np.diff(times), 0.1, rtol=1e-6)
+    k = np.arange(len(times))
+    assert np.all((times >= 0.1 * k - 1e-12) & (times < 0.1 * k + run.run_json["dt_max_s"]))
 
 
 def test_stored_points_conserve_mass(plate_runs, small_plate):
@@ -70,28 +72,31 @@ def test_simulation_by_hand_matches_the_run(small_plate, plate_runs):
     """Stepping a Simulation gives the forces the run wrote, step for step (force_interval 0)."""
     sim = furrow.Simulation(small_plate)
     plate = furrow.open_run(plate_runs["py"]).forces["plate"]
-    for k in range(50):
+    fy = []
+    for k in range(700):  # the plate reaches the bed after ~400 steps
         sim.step()
-        b = sim.bodies()[0]
-        assert b["name"] == "plate"
-        assert sim.time_s == pytest.approx(plate["t_s"][k], rel=1e-12)
-        assert b["force_N_per_m"]["y"] == pytest.approx(plate["Fy_N_per_m"][k], rel=1e-5, abs=1e-9)
+        assert sim.time_s == pytest.approx(plate["t_s"][k], rel=1e-8)  # forces.csv's 9 digits
+        fy.append(sim.bodies()[0]["force_N_per_m"]["y"])
+    assert sim.bodies()[0]["name"] == "plate"
+    assert np.count_nonzero(fy) > 100
+    np.testing.assert_allclose(fy, plate["Fy_N_per_m"][:700], rtol=1e-8, atol=1e-12)
 
 
-def test_hydrostatic_stress_at_the_base():
-    """A settled bed carries its weight: the vertical stress of the bottom points is rho g depth,
-    within half a cell's weight of material (where in its cell a point sits), and the bottom wall
-    holds the bed's weight."""
-    dx = 0.01
+def test_hydrostatic_stress_of_a_settled_bed():
+    """A settled bed carries its weight: above the floor's cell (whose points see the wall's half
+    stencil) a point's vertical stress is rho g depth within half a cell's weight of material
+    (where in its cell the point sits), and the floor holds the bed's weight."""
+    dx, surface_m = 0.01, 0.1
     scene = furrow.new_scene("hydrostatic_bed", set={"domain.dx_m": dx, "solver.threads": 1})
     sim = furrow.Simulation(scene)
-    rho, g, surface_m = 2520.0 * 0.6, 9.81, 0.1
-    sim.step(400)  # 24 ms: ~15 crossings of the bed by the elastic wave
+    rho, g = 2520.0 * 0.6, 9.81
+    sim.step(1000)  # 60 ms: ~40 crossings of the bed by the elastic wave
     p = sim.particles()
     sigma_yy = -p["pressure_Pa"].astype(float) + p["syy_Pa"]
-    bottom = p["y_m"] < p["y_m"].min() + dx / 4
-    depth = surface_m - p["y_m"][bottom]
-    assert np.abs(sigma_yy[bottom] + rho * g * depth).max() < rho * g * dx / 2
+    above_floor_cell = p["y_m"] > dx
+    depth = surface_m - p["y_m"][above_floor_cell]
+    assert np.abs(sigma_yy[above_floor_cell] + rho * g * depth).max() < rho * g * dx / 2
+    # the floor: the bed's weight, to the 3% of the engine's own test (the bed still rings a little)
     weight = sim.total_mass_kg_per_m * g
-    assert sim.wall_forces()[2]["y"] == pytest.approx(-weight, rel=0.02) or \
-        sim.wall_forces()[2]["y"] == pytest.approx(weight, rel=0.02)
+    assert weight == pytest.approx(rho * 0.2 * surface_m * g, rel=1e-6)
+    assert -sim.wall_forces()[2]["y"] == pytest.approx(weight, rel=0.03)

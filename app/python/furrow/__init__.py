@@ -102,13 +102,15 @@ def scene_from_dict(d, set=None, allow_large=False, source="<dict>"):
 
 
 def run(scene, out, threads=None, progress=None, progress_interval_s=0.5, force=False, paraview=True,
-        checkpoint_every_min=0, resume=False, resume_any_build=False):
+        checkpoint_every_min=30, resume=False, resume_any_build=False):
     """Runs `scene` into the run directory `out` (what `furrow run` writes, without movies: render
     them with `furrow render`). The solver runs with the GIL released; `progress(dict)` is called
     every progress_interval_s with fraction, time_s, steps, wall_s, eta_s, particles, dt_s.
     Ctrl-C, or an exception in `progress`, stops the run after the current step with a checkpoint
     (resume=True continues it bit-identically) and is raised again; furrow.StopRun instead returns
-    the summary with stopped=True. Returns {run_json, bodies, out_dir, stopped, resumed_from_step}."""
+    the summary with stopped=True. Checkpoints also every checkpoint_every_min minutes of wall time
+    (0: never), as the CLI's --checkpoint-every. Returns {run_json, bodies, out_dir, stopped,
+    resumed_from_step}."""
     if isinstance(scene, (str, os.PathLike)):
         scene = load_scene(scene)
     if threads is not None:
