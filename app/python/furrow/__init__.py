@@ -57,8 +57,16 @@ class Scene:
         return self._s.text()
 
     def save(self, path):
-        with open(path, "x") as f:  # never overwrites
+        """Writes the resolved scene to `path`, which must not exist (written beside it, then linked
+        into place: never half a file, never over another)."""
+        path = os.fspath(path)
+        tmp = f"{path}.tmp-{os.getpid()}"
+        with open(tmp, "w") as f:
             f.write(self.text())
+        try:
+            os.link(tmp, path)  # fails if path exists
+        finally:
+            os.unlink(tmp)
 
     def with_set(self, set):
         """A new scene with `set` overrides applied (errors name the override)."""
