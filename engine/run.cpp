@@ -1,5 +1,6 @@
 #include "engine/run.hpp"
 
+#include <dlfcn.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <tbb/info.h>
@@ -76,7 +77,14 @@ std::string scene_hash(const Scene& scene) { return fnv1a_hex(result_defining_js
 
 const std::string& build_id() {
   static const std::string id = [] {
-    std::ifstream in("/proc/self/exe", std::ios::binary);
+    // the file holding this code: the executable, or the Python module (a shared object) that
+    // links the engine, so a checkpoint names that module's build and not the interpreter's
+    std::string file = "/proc/self/exe";
+    Dl_info info{};
+    if (dladdr(reinterpret_cast<void*>(&build_id), &info) && info.dli_fname &&
+        std::string(info.dli_fname).find(".so") != std::string::npos)
+      file = info.dli_fname;
+    std::ifstream in(file, std::ios::binary);
     std::ostringstream bytes;
     bytes << in.rdbuf();
     return std::string(FURROW_VERSION) + "-" + (in ? fnv1a_hex(bytes.str()) : std::string("unknown"));

@@ -88,8 +88,9 @@ std::vector<std::string> checkpoint_dirs(const std::string& out_dir);
 // Whether process `pid` exists on this machine (a DIR.partial-PID still being written).
 bool process_running(long pid);
 
-// This program's build: Furrow's version and a hash of the running executable (checkpoints and
-// run.json record it; the same sources built the same way give the same id).
+// This program's build: Furrow's version and a hash of the running executable, or of the Python
+// module that holds the engine (checkpoints and run.json record it; the same sources built the
+// same way give the same id).
 const std::string& build_id();
 
 // Peak resident memory of this process (bytes).
