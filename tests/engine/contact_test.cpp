@@ -94,20 +94,21 @@ TEST(ContactSmoothness, LooseIntrusionHasNoSpikes) {
 }
 
 // Cell-fraction contact on the same two templates. plate_intrusion (its plate's sides lie on node
-// lines): 1.133x, RMS 1.61%, cell component 0.86% (node 1.46x, 8.9%, 7.8%); the same plate half a
-// cell off the node lines: 1.086x, 1.11%, 0.84%. Before the share reached 1 inside the body
-// (2026-12-02) the first was 1.151x: points riding the plate's leading face near its corners,
-// kicked into it by FLIP and put back by G2P's safety net (engine/README.md, "Body contact"). The
-// mass-gradient normal this method used before met the peak (1.13x) but not the rest half a cell
-// sideways (2.15%, 2.0%); its first form, a ramp, met the first case (1.12x, 2.4%, 2.05%) but not
-// the second (1.09x, 5.3%, 5.9%), which is why the test runs both. loose_intrusion: 1.14x from
-// three cells of penetration at dx 2.5 mm (node 4.8x); 1.061x, RMS 2.05% at its 2 mm preview.
+// lines): 1.038x, RMS 1.45%, cell component 0.68%, largest single-step tick 0.65% (node 1.46x,
+// 8.9%, 7.8%); half a cell off the node lines: 1.027x, 1.13%, 1.00%, 0.71%. Until 2026-12-04
+// G2P's safety net took a point's approach out of its velocity as it put it back on the plate's
+// face, which put single-step ticks of up to 16.8% on the force and a 1.133x peak; the tick bound
+// (2%) is what that fix holds. The mass-gradient normal this method used before met the peak
+// (1.13x) but not the rest half a cell sideways (2.15%, 2.0%); its first form, a ramp, met the
+// first case (1.12x, 2.4%, 2.05%) but not the second (1.09x, 5.3%, 5.9%), which is why the test
+// runs both. loose_intrusion: 1.054x, RMS 1.97%, tick 0.12% over 23 mm at its 2 mm preview.
 TEST(ContactSmoothness, CellFractionPlateIntrusionHasNoCellComb) {
   for (double shift_cells : {0.0, 0.5}) {
     const ForceSmoothness f = plate_intrusion_smoothness(ContactMethod::CellFraction, shift_cells);
-    EXPECT_LE(f.peak_ratio, 1.15) << "shifted " << shift_cells << " cell";
+    EXPECT_LE(f.peak_ratio, 1.05) << "shifted " << shift_cells << " cell";
     EXPECT_LE(f.cell_amplitude_relative, 0.02) << "shifted " << shift_cells << " cell";
     EXPECT_LE(f.rms_relative, 0.02) << "shifted " << shift_cells << " cell";
+    EXPECT_LE(f.tick_max_relative, 0.02) << "shifted " << shift_cells << " cell";
   }
 }
 
@@ -115,6 +116,7 @@ TEST(ContactSmoothness, CellFractionLooseIntrusionHasNoSpikes) {
   const ForceSmoothness f = loose_intrusion_smoothness(ContactMethod::CellFraction, 0.025);  // 23 of its 60 mm
   EXPECT_LE(f.peak_ratio, 1.2);
   EXPECT_LE(f.cell_amplitude_relative, 0.02);
+  EXPECT_LE(f.tick_max_relative, 0.02);
 }
 
 // Onset: a 0.04 m plate descending at 0.1 m/s from 2 cells (10 mm) above a bed, dx 5 mm. Until
