@@ -335,6 +335,8 @@ double pair_normalized(const Trace& t, double L, double s_over_L, DepthWindow wi
 // Those four samples rose from 0.3 to 0.6 and could not show where the peak sits; s/L 1 and 1.5
 // (since 2026-12-05) put samples past it, so the test sees a maximum with lower values on both sides
 // (PaperClaimMeasures.InteriorPeakNeedsLowerValuesPastIt: a curve still rising at 1.5 fails).
+// Measured 2026-12-05: 11.13 / 13.15 / 13.91 / 13.42 / 13.48 / 10.91 at s/L 0 / 0.3 / 0.6 / 1 / 1.5 /
+// inf: the top is broad (0.6 is 3.2-3.6% above 1 and 1.5); 71 s on 2 loaded cores.
 TEST(PaperCase2, PlatePairDragPeaksAtSmallSeparation) {
   const double L = 0.025;
   const std::vector<double> s_over_L = {0.0, 0.3, 0.6, 1.0, 1.5, -1.0};  // increasing, s -> inf last
