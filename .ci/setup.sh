@@ -4,7 +4,7 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config ccache git
       libeigen3-dev libtbb-dev nlohmann-json3-dev libopenvdb-dev libboost-iostreams-dev libblosc-dev
       libvtk9-dev libosmesa6-dev libimgui-dev libglfw3-dev
-      libgtest-dev libgmock-dev libbenchmark-dev ffmpeg valgrind xvfb openmpi-bin libopenmpi-dev
+      libgtest-dev libgmock-dev libbenchmark-dev ffmpeg valgrind xvfb libxtst6 openmpi-bin libopenmpi-dev
       python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest)
 missing=()
 for p in "${pkgs[@]}"; do

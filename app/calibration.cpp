@@ -53,6 +53,8 @@ std::optional<Calibration> load_calibration(std::string* why) {
     c.date = j.value("date", "");
     c.particles = j.value("particles", size_t(0));
     c.size_exponent = j.value("size_exponent", 0.0);
+    c.large_particles = j.value("large_particles", size_t(0));
+    c.large_particle_steps_per_s = j.value("large_particle_steps_per_s", 0.0);
     for (const auto& e : j.at("entries"))
       c.entries.push_back({e.at("shape_function").get<std::string>(), e.at("model").get<std::string>(),
                            e.at("threads").get<int>(), e.at("particle_steps_per_s").get<double>()});
@@ -70,6 +72,8 @@ void save_calibration(const Calibration& c) {
   j["date"] = c.date;
   j["particles"] = c.particles;
   j["size_exponent"] = c.size_exponent;
+  j["large_particles"] = c.large_particles;
+  j["large_particle_steps_per_s"] = c.large_particle_steps_per_s;
   j["units"] = "particle_steps_per_s: particles times solver steps per wall second";
   j["entries"] = nlohmann::json::array();
   for (const auto& e : c.entries)

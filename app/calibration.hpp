@@ -21,8 +21,12 @@ struct Calibration {
   size_t particles = 0;        // size of the bench scene
   // Larger beds run slower (their particle and grid arrays leave the caches): the rate falls as
   // (N / particles)^size_exponent, measured between the bench scene and one 16 times larger
-  // (quadratic NDPM, all threads). 0 when not measured (calibrations before 2026-12-01).
+  // (quadratic NDPM, all threads). 0 when not measured (calibrations before 2026-12-01). Stored as
+  // measured (a noisy bench can read it above 0); predictions use it clamped to [-0.5, 0].
   double size_exponent = 0.0;
+  // the larger bed's measurement the exponent came from (0 when not measured)
+  size_t large_particles = 0;
+  double large_particle_steps_per_s = 0.0;
   std::vector<CalibrationEntry> entries;
   std::string path;            // where it was read from / is written to
 };

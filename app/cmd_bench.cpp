@@ -127,7 +127,9 @@ int bench_main(const Parsed& p) {
     Simulation sim(bench_scene(ShapeFunction::Quadratic, false, thread_counts.back(), 0.00125));
     const double rate = measure_rate(sim, seconds, nullptr);
     const double ratio = double(sim.particles().size()) / double(c.particles);
-    c.size_exponent = std::min(0.0, std::log(rate / reference_rate) / std::log(ratio));
+    c.large_particles = sim.particles().size();
+    c.large_particle_steps_per_s = rate;
+    c.size_exponent = std::log(rate / reference_rate) / std::log(ratio);  // as measured; predictions clamp it
     std::printf("%-10s %-5s %7d %19.2f   at %zu particles: rate ~ particles^%.3f above %zu\n", "quadratic", "ndpm",
                 thread_counts.back(), rate / 1e6, sim.particles().size(), c.size_exponent, c.particles);
   }

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -74,6 +76,14 @@ int parse_jobs(const Parsed& p) {
   return int(n);
 }
 
+long long sigterm_self_at(const char* name) {
+  const char* v = std::getenv(name);
+  if (!v || !*v) return 0;
+  char* end = nullptr;
+  const long long n = std::strtoll(v, &end, 10);
+  return *end == '\0' && n > 0 ? n : 0;
+}
+
 namespace {
 
 volatile sig_atomic_t g_stop_signal = 0;
@@ -129,7 +139,10 @@ static int run_main(const Parsed& p) {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
-  opt.stop_requested = [] { return g_stop_signal != 0; };
+  opt.stop_requested = [sigterm_at = sigterm_self_at("FURROW_SIGTERM_AT_STEP"), steps = 0LL]() mutable {
+    if (sigterm_at > 0 && ++steps == sigterm_at) std::raise(SIGTERM);  // polled once a step
+    return g_stop_signal != 0;
+  };
   ProgressPrinter progress(scene.name, p.has("--quiet"));
   opt.progress = [&](const RunProgress& r) { progress(r); };
   RunSummary s;
@@ -197,7 +210,9 @@ Command command_run() {
             "stops the run with exit status 130. The same command with --resume continues from there with\n"
             "results identical to an uninterrupted run (any thread count); run.json's wall and solver\n"
             "seconds are summed over the segments. A checkpoint is resumed only by the build that wrote\n"
-            "it (run.json \"build\": version and executable hash) unless --resume-any-build is given.",
+            "it (run.json \"build\": version and executable hash) unless --resume-any-build is given.\n"
+            "FURROW_SIGTERM_AT_STEP=N in the environment makes the run send itself SIGTERM after step N\n"
+            "(N counted from this segment's start; for tests of the stop).",
             {{"--out", true, false, "run directory (default out/<scene name>)", "DIR"},
              {"--force", false, false, "replace an existing run directory once the new run completes"},
              {"--no-movies", false, false, "skip rendering movies"},

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -228,6 +229,8 @@ int study_main(const Parsed& p) {
   const auto calibration = load_calibration();  // predicts the first rung, when there is one
   std::map<pid_t, Job> running;
   size_t next = 0, finished = reused, failed = 0;
+  const long long sigterm_after = sigterm_self_at("FURROW_SIGTERM_AFTER_RUNGS");
+  long long finished_here = 0;
   const auto t0 = std::chrono::steady_clock::now();
   while ((next < order.size() || !running.empty()) && !g_stop) {
     while (next < order.size() && int(running.size()) < jobs && !g_stop) {
@@ -269,8 +272,11 @@ int study_main(const Parsed& p) {
         continue;
       }
       running[pid] = {r, std::chrono::steady_clock::now()};
+      // FURROW_SIGTERM_AFTER_RUNGS (tests of the stop): the signal arrives with a rung running
+      if (sigterm_after > 0 && finished_here == sigterm_after) std::raise(SIGTERM);
     }
-    if (running.empty()) break;
+    // a stop that came while rungs were being started must not wait for them to finish
+    if (running.empty() || g_stop) break;
     int status = 0;
     const pid_t pid = ::waitpid(-1, &status, 0);
     if (pid < 0) {
@@ -284,6 +290,7 @@ int study_main(const Parsed& p) {
     running.erase(it);
     auto& g = rungs[r];
     ++finished;
+    ++finished_here;
     const bool exited_ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
     if (exited_ok) {
       try {
@@ -367,7 +374,8 @@ Command command_study() {
             "(threads, movies aside) and runs the rest. A directory holding a different run is an error (nothing\n"
             "runs). Threads per rung: cores / N unless the scene or --threads sets them; for timings that\n"
             "compare, keep --jobs 1. Rungs write no movies and no ParaView files; each rung's scene is in\n"
-            "DIR/scenes and its output in DIR/logs.",
+            "DIR/scenes and its output in DIR/logs. FURROW_SIGTERM_AFTER_RUNGS=N in the environment makes\n"
+            "the study send itself SIGTERM as it starts a rung after N have finished (for tests of the stop).",
             {{"--ladder", true, true, "a key path and its rungs: key.path=v1,v2,v3 or key.path=a:b:step", "KEY=VALUES"},
              {"--quantity", true, false, "drag_mean (default), lift_mean, peak_force or wedge_angle", "Q"},
              {"--body", true, false, "the body whose force is read (default: the first moving body)", "NAME"},

@@ -33,6 +33,11 @@ std::vector<sweep::Vary> parse_varies(const Parsed& p, const std::string& option
 void parse_size(const std::string& s, int* w, int* h);
 // The CLI's worker count option (--jobs N, 1..1024, default 1); throws UsageError.
 int parse_jobs(const Parsed& p);
+// For tests that stop a run or a study by a signal at a known point rather than at a wall-clock
+// moment: the count in environment variable `name` (FURROW_SIGTERM_AT_STEP for run,
+// FURROW_SIGTERM_AFTER_RUNGS for study), after which the command sends itself SIGTERM; 0 when
+// unset or not a positive whole number (app/cmd_run.cpp).
+long long sigterm_self_at(const char* name);
 // The view options of inspect and edit (--headless, --script, --exit-after-script, --size WxH):
 // throws UsageError for a bad combination; returns 2, after saying why on stderr, when a window is
 // wanted but none can open here, else 0 (app/cmd_inspect.cpp).

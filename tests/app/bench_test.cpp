@@ -108,7 +108,18 @@ TEST_F(BenchCli, BenchStoresAFigureForEveryShapeFunctionModelAndThreadCount) {
   }
   const size_t thread_counts = std::thread::hardware_concurrency() > 1 ? 2 : 1;
   EXPECT_EQ(seen.size(), 3 * 2 * thread_counts);
-  EXPECT_LE(c.at("size_exponent").get<double>(), 0.0);  // measured on a bed 16 times larger
+  // the size exponent is what was measured on a bed 16 times larger, not a clamped figure: the
+  // log of the two rates over the log of the two sizes (a NaN or a stored 0 fails here)
+  double reference_rate = std::nan("");
+  int most_threads = 0;  // the reference: quadratic NDPM on the most threads measured
+  for (const auto& e : c.at("entries"))
+    if (e.at("shape_function") == "quadratic" && e.at("model") == "ndpm" && e.at("threads").get<int>() > most_threads)
+      most_threads = e.at("threads").get<int>(), reference_rate = e.at("particle_steps_per_s").get<double>();
+  const double large = c.at("large_particles").get<double>(), small = c.at("particles").get<double>();
+  EXPECT_NEAR(large / small, 16.0, 1.0);
+  const double measured = std::log(c.at("large_particle_steps_per_s").get<double>() / reference_rate) / std::log(large / small);
+  ASSERT_TRUE(std::isfinite(measured));
+  EXPECT_NEAR(c.at("size_exponent").get<double>(), measured, 1e-9);
   const auto [psteps, wall] = validate();
   EXPECT_EQ(wall.find("unknown"), std::string::npos) << wall;
   EXPECT_NE(wall.find("on this machine"), std::string::npos) << wall;

@@ -207,9 +207,9 @@ namespace {
 
 TEST_F(EditCli, WindowUnderXvfbReplaysAScriptAndSaves) {
   if (std::system("command -v Xvfb >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "Xvfb is not installed (apt-get install xvfb, as .ci/setup.sh does): no display to open the window on";
+    FURROW_SKIP_UNLESS_CI("Xvfb is not installed (apt-get install xvfb, as .ci/setup.sh does): no display to open the window on");
   furrow::cli_test::Xvfb x;
-  if (!x.up) GTEST_SKIP() << "Xvfb could not start on display :" << x.number;
+  if (!x.up) FURROW_SKIP_UNLESS_CI("Xvfb could not start");
   std::ofstream(path("script.txt")) << "move plate 0.4 0.64\nsave " + path("moved.json") + "\n";
   setenv("DISPLAY", (":" + std::to_string(x.number)).c_str(), 1);
   const auto r = run({"edit", path("orig.json"), "--script", path("script.txt"), "--exit-after-script"});
@@ -282,10 +282,10 @@ struct EditWindow {
 
   // stdout and stderr of the editor go to those files
   EditWindow(const std::string& scene, const std::string& out, const std::string& err) {
-    if (!xt.ok()) { skip = "libXtst.so.6 (XTest) is not installed: no way to drive the window"; return; }
+    if (!xt.ok()) { skip = "libXtst.so.6 (XTest, package libxtst6) is not installed: no way to drive the window"; return; }
     if (std::system("command -v Xvfb >/dev/null 2>&1") != 0) { skip = "Xvfb is not installed"; return; }
     x = std::make_unique<furrow::cli_test::Xvfb>();
-    if (!x->up) { skip = "Xvfb could not start on display :" + std::to_string(x->number); return; }
+    if (!x->up) { skip = "Xvfb could not start"; return; }
     const std::string display = ":" + std::to_string(x->number);
     pid = fork();
     if (pid == 0) {
@@ -324,7 +324,7 @@ struct EditWindow {
 
 TEST_F(EditCli, WindowDragMovesABodyAndCtrlSSavesBesideTheScene) {
   EditWindow w(path("orig.json"), path("stdout"), path("stderr"));
-  if (!w.skip.empty()) GTEST_SKIP() << w.skip;
+  if (!w.skip.empty()) FURROW_SKIP_UNLESS_CI(w.skip);
   ASSERT_GE(w.wx, 0) << "no editor window appeared";
   // drag the plate from its centre 0.2 m to the left
   pause_ms(300);
@@ -363,7 +363,7 @@ TEST_F(EditCli, WindowDragMovesABodyAndCtrlSSavesBesideTheScene) {
 // view draws it off-screen), type 0.02, Enter, Ctrl+S.
 TEST_F(EditCli, WindowTypedValueIsSetAndSaved) {
   EditWindow w(path("orig.json"), path("stdout"), path("stderr"));
-  if (!w.skip.empty()) GTEST_SKIP() << w.skip;
+  if (!w.skip.empty()) FURROW_SKIP_UNLESS_CI(w.skip);
   ASSERT_GE(w.wx, 0) << "no editor window appeared";
   pause_ms(300);
   // where the row is: the same panel drawn off-screen at the window's default size

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -164,17 +166,40 @@ TEST_F(StudyCli, TableAgreesWithItsRunsAndARerunReusesThem) {
   // rows follow the ladder; the table's extrapolation is the three rungs' Richardson value
   ASSERT_GT(h[0], h[1]);
   ASSERT_GT(h[1], h[2]);
+  // the tiny plate's drag over this ladder converges monotonically (its differences keep their
+  // sign), so the three rungs have a Richardson value and the table must hold it
   const auto rich = furrow::study::richardson(h[0], q[0], h[1], q[1], h[2], q[2]);
-  if (rich.ok) {
-    EXPECT_NEAR(std::stod(t.rows[2].at("extrapolated_N_per_m")), rich.extrapolated, 1e-6 * std::abs(rich.extrapolated));
-    EXPECT_NEAR(std::stod(t.rows[0].at("observed_order")), rich.order, 1e-3);
-  }
+  std::printf("drag %.6g / %.6g / %.6g N/m at dx %g / %g / %g m: Richardson %.6g, order %.3g\n", q[0], q[1], q[2], h[0],
+              h[1], h[2], rich.extrapolated, rich.order);
+  ASSERT_TRUE(rich.ok) << rich.note;
+  EXPECT_NEAR(std::stod(t.rows[2].at("extrapolated_N_per_m")), rich.extrapolated, 1e-6 * std::abs(rich.extrapolated));
+  EXPECT_NEAR(std::stod(t.rows[0].at("observed_order")), rich.order, 1e-3 * std::max(1.0, std::abs(rich.order)));
   EXPECT_EQ(std::stod(t.rows[2].at("diff_from_finest_N_per_m")), 0.0);
-  // every rung after the first was predicted, and the finest within a factor 3 of what it took
+  // every rung after the first was predicted from the rungs finished before it (one at a time,
+  // cheapest first), as predict_wall_s says from their stored wall times and particle-step
+  // estimates: checked against that arithmetic, not against the clock (the wall times are the
+  // machine's load; how close the prediction came is printed)
   EXPECT_TRUE(t.rows[0].at("predicted_wall_s").empty());
-  const double predicted = std::stod(t.rows[2].at("predicted_wall_s")), took = std::stod(t.rows[2].at("wall_s"));
-  EXPECT_GT(predicted, took / 3.0);
-  EXPECT_LT(predicted, took * 3.0);
+  const auto sj = nlohmann::json::parse(read_text(fs::path(out) / "study.json"));
+  ASSERT_EQ(sj.at("rungs").size(), 3u);
+  std::vector<Rung> done(3);
+  for (size_t i = 0; i < 3; ++i) {
+    const auto& e = sj.at("rungs")[i];
+    done[i].dir = e.at("dir").get<std::string>();
+    done[i].wall_s = e.at("wall_s").get<double>();
+    done[i].estimated_particle_steps = e.at("estimated_particle_steps").get<double>();
+  }
+  ASSERT_LT(done[0].estimated_particle_steps, done[1].estimated_particle_steps);
+  ASSERT_LT(done[1].estimated_particle_steps, done[2].estimated_particle_steps);
+  for (size_t i = 1; i < 3; ++i) {
+    done[i - 1].ok = true;
+    std::string basis;
+    const double expected = furrow::study::predict_wall_s(done, done[i], &basis);
+    const double predicted = std::stod(t.rows[i].at("predicted_wall_s")), took = std::stod(t.rows[i].at("wall_s"));
+    std::printf("rung %zu: predicted %.3g s, took %.3g s\n", i, predicted, took);
+    EXPECT_NEAR(predicted, expected, 1e-3 * expected) << t.rows[i].at("rung");
+    EXPECT_NEAR(sj.at("rungs")[i].at("predicted_wall_s").get<double>(), expected, 1e-9 * expected);
+  }
   EXPECT_TRUE(fs::exists(fs::path(out) / "study.png"));
   EXPECT_NE(read_text(fs::path(out) / "study.md").find("| rung |"), std::string::npos);
 
@@ -218,39 +243,28 @@ TEST_F(StudyCli, StoredCalibrationPredictsTheFirstRung) {
 
 TEST_F(StudyCli, StoppedStudyKeepsFinishedRungsAndFinishesOnRerun) {
   const std::string out = path("s");
-  const std::string cmd = furrow::cli_test::quote(FURROW_CLI_PATH) + " study " +
+  // The study sends itself SIGTERM as it starts the third rung, the two cheap ones done
+  // (FURROW_SIGTERM_AFTER_RUNGS), through the handler Ctrl-C reaches: on any machine the stop finds
+  // two rungs finished and the finest running, which it stops and whose partial run it removes.
+  const std::string cmd = "FURROW_SIGTERM_AFTER_RUNGS=2 exec " + furrow::cli_test::quote(FURROW_CLI_PATH) + " study " +
                           furrow::cli_test::quote(path("tiny.json")) +
                           " --ladder domain.dx_m=0.01,0.005,0.0025 --quiet --out " + furrow::cli_test::quote(out);
-  // Start it and stop it once the two cheap rungs are in the table (the finest takes several times
-  // longer). On a loaded machine the finest can still beat the stop: then start afresh, up to 3 times.
   auto ok_rungs = [&] {
     int n = 0;
     for (const auto& row : read_csv(fs::path(out) / "study.csv").rows) n += row.count("status") && row.at("status") == "ok";
     return n;
   };
-  int status = 0, ok = 0;
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    fs::remove_all(out);
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      ::execl("/bin/sh", "sh", "-c", ("exec " + cmd + " >/dev/null 2>&1").c_str(), (char*)nullptr);
-      ::_exit(127);
-    }
-    bool two_done = false;
-    for (int i = 0; i < 600 && !two_done; ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      two_done = fs::exists(fs::path(out) / "study.csv") && ok_rungs() >= 2;
-    }
-    ::kill(pid, two_done ? SIGTERM : SIGKILL);
-    ::waitpid(pid, &status, 0);
-    ASSERT_TRUE(two_done);
-    ok = ok_rungs();
-    if (ok < 3) break;
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", (cmd + " >/dev/null 2>" + furrow::cli_test::quote(path("stderr"))).c_str(), (char*)nullptr);
+    ::_exit(127);
   }
-  if (ok == 3) GTEST_SKIP() << "three times the last rung finished before the stop arrived";
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130);
-  EXPECT_EQ(ok, 2);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const int ok = ok_rungs();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130) << read_text(path("stderr"));
+  EXPECT_EQ(ok, 2) << read_text(path("stderr"));
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
   const auto r = run({"study", path("tiny.json"), "--ladder", "domain.dx_m=0.01,0.005,0.0025", "--out", out});

@@ -133,7 +133,7 @@ bool timing_column(const std::string& name) { return name == "wall_s"; }
 }  // namespace
 
 TEST_F(SweepResume, ThreeMpiRanksWriteTheTableOfOneProcess) {
-  if (const std::string why = mpi_unavailable(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = mpi_unavailable(); !why.empty()) FURROW_SKIP_UNLESS_CI(why);
   const Result local = run(sweep(kSixRuns, "local"));
   ASSERT_EQ(local.status, 0) << local.err;
   Child c = start(mpirun(3, sweep(kSixRuns, "mpi")), kMpiEnv);
@@ -197,7 +197,7 @@ TEST_F(SweepResume, SceneWithMoviesIsReusedBySweepsThatDoNotRenderThem) {
 }
 
 TEST_F(SweepResume, StoppedMpiJobRunsOnlyTheMissingRunsAgain) {
-  if (const std::string why = mpi_unavailable(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = mpi_unavailable(); !why.empty()) FURROW_SKIP_UNLESS_CI(why);
   // runs long enough (dx 2.5 mm) that the second pair cannot finish while the stop reaches the ranks
   const std::vector<std::string> vary = {"--vary", "domain.dx_m=0.0025", "--vary", "bodies.rod.start_m.1=0.025:0.04:0.005"};
   const auto before = stop_after_first_run(mpirun(2, sweep(vary, "sw")), kMpiEnv, path("sw"));

@@ -123,7 +123,8 @@ TEST(ContactSmoothness, CellFractionLooseIntrusionHasNoSpikes) {
 // its face is within a quarter cell of the material's surface it feels less than 1% of its force
 // after one cell of penetration (measured: exactly 0 of 189 N/m with particle contact, 0 of 137
 // with cell_fraction, which starts a fifth of a cell out); node contact feels the bed early
-// (40 N/m, 37% of its 109 N/m at one cell).
+// (40 N/m, 37% of its 109 N/m at one cell). Node's early force is printed, not asserted: it is the
+// artifact particle and cell-fraction contact remove, and a fix of node contact must not fail a test.
 TEST(ContactOnset, ParticleAndCellFractionContactStartWhenTheSurfacesMeet) {
   const double dx = 0.005, gap = 2 * dx, bed_top = 0.1;
   for (ContactMethod method : {ContactMethod::Particle, ContactMethod::CellFraction, ContactMethod::Node}) {
@@ -148,9 +149,8 @@ TEST(ContactOnset, ParticleAndCellFractionContactStartWhenTheSurfacesMeet) {
     std::printf("%s contact: force at one cell %.1f N/m, largest before the surfaces meet %.3f N/m\n",
                 contact_method_name(method), at_one_cell, before);
     ASSERT_GT(at_one_cell, 0.0);
-    if (method != ContactMethod::Node)
+    if (method != ContactMethod::Node) {
       EXPECT_LT(before, 0.01 * at_one_cell);
-    else
-      EXPECT_GT(before, 0.01 * at_one_cell);  // the artifact particle contact removes
+    }
   }
 }

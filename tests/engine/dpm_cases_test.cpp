@@ -6,16 +6,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include "engine/analysis.hpp"
 #include "engine/field_store.hpp"
 #include "engine/simulation.hpp"
+#include "tests/engine/paper_claims.hpp"
 #include "tests/engine/test_scenes.hpp"
 
 using namespace furrow;
 using test_scenes::bed_scene;
 using test_scenes::plate;
+using paper::approaches;
 
 namespace {
 
@@ -290,19 +293,29 @@ TEST(DpmLooseIntrusion, RigidWedgeSharpensToTheSlipLineAngle) {
   }
   const double early_apex = median_finite(early_deg), late_apex = median_finite(late_deg);
   const double slip_line = slip_line_apex_angle_deg(0.53);
+  std::printf("case 4: apex early %.1f deg, late %.1f deg (slip line %.1f deg at mu_c)\n", early_apex, late_apex,
+              slip_line);
   RecordProperty("early_apex_deg", std::to_string(early_apex));
   RecordProperty("late_apex_deg", std::to_string(late_apex));
   ASSERT_GE(early_deg.size(), 6u);
   ASSERT_EQ(late_frames, 30);  // 20 mm = 10 cells, 3 frames each
   // the zone exists and has flanks in nearly every late frame
   EXPECT_GE(std::count_if(late_deg.begin(), late_deg.end(), [](double a) { return std::isfinite(a); }), 27);
-  EXPECT_NEAR(late_apex, slip_line, 8.0) << "early " << early_apex << ", late " << late_apex;
+  // it sharpens to the slip-line angle at mu_c: from the initial friction's (74.4 deg) to within a
+  // third of the way of mu_c's (62.1 +- 4.1 deg); a zone stuck at 74.4 deg or gone halfway fails
+  // (PaperClaimMeasures.WedgeApproachRejectsAZoneThatDidNotSharpen; the bound until 2026-12-05,
+  // 62.1 +- 8 deg, accepted 70 deg)
+  const MaterialParams bed = MaterialParams::from(s.materials[0], true);
+  const double initial_slip_line = slip_line_apex_angle_deg(bed.friction(s.beds[0].packing_fraction));
+  EXPECT_TRUE(approaches(late_apex, slip_line, initial_slip_line))
+      << "early " << early_apex << ", late " << late_apex << ", slip line " << slip_line << " from " << initial_slip_line;
   EXPECT_GE(early_apex, late_apex + 5.0) << "early " << early_apex << ", late " << late_apex;
   // it grows: early no taller than the slip-line wedge at the initial friction, scaled to the late one
   const double early_height = median_finite(early_h), late_height = median_finite(late_h);
-  const MaterialParams bed = MaterialParams::from(s.materials[0], true);
   const auto half_tan = [](double mu) { return std::tan(0.5 * slip_line_apex_angle_deg(mu) * M_PI / 180.0); };
   const double full_wedge_ratio = half_tan(bed.mu) / half_tan(bed.friction(s.beds[0].packing_fraction));  // 0.79
   RecordProperty("early_over_late_height", std::to_string(early_height / late_height));
+  std::printf("case 4: early height %.1f mm, late %.1f mm (%.3f; bound %.2f)\n", 1e3 * early_height, 1e3 * late_height,
+              early_height / late_height, full_wedge_ratio);
   EXPECT_LT(early_height, full_wedge_ratio * late_height) << "early " << early_height << ", late " << late_height;
 }

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "engine/materials.hpp"
 #include "tests/engine/test_scenes.hpp"
@@ -227,16 +228,37 @@ TEST(RateDependence, ReturnIsBoundedAtExtremeRatesAndPressures) {
   const auto p = mu_i(MaterialModel::NDPM);
   PlasticityModel<false, true> rate{p};
   PlasticityModel<false, false> plain{p};
-  const double mass = 1e-3;
+  const double mass = 1e-3, mu_s = 0.38, mu_2 = 0.64;
+  int flowing = 0;
   for (double P0 : {1e-9, 1e-3, 1.0, 1e3, 1e6})
     for (double gdot : {1e-6, 1.0, 1e3, 1e8}) {
       PointState s = dense_point(p, P0, p.phi_c, mass);
       for (int i = 0; i < 50; ++i) rate.update(1e-5, 0.0, gdot, 0.0, 0.0, mass, s);
       const double r = tau_of(s) / s.pressure_Pa;
       ASSERT_TRUE(std::isfinite(r)) << P0 << " " << gdot;
-      EXPECT_LE(r, 0.64 * (1.0 + 1e-9)) << "P " << P0 << " rate " << gdot;
-      EXPECT_GE(tau_of(s), 0.0);
+      EXPECT_LE(r, mu_2 * (1.0 + 1e-9)) << "P " << P0 << " rate " << gdot;
+      // a point that flows sits on the yield surface, never under mu_s (an elastic one may)
+      if (s.strain_rate_1_s > 0.0) {
+        EXPECT_GE(r, mu_s * (1.0 - 1e-9)) << "P " << P0 << " rate " << gdot;
+        ++flowing;
+      }
     }
+  EXPECT_GE(flowing, 8) << "the extremes must make points flow for the lower bound to be tested";
+  // both bounds reached: steady shear (1e-3 strain a step, one unit of strain) at I from 1e-7 to
+  // 1e4 at P 1 kPa reads mu(I) within 0.1% of it, from mu_s (mu(1e-7) - mu_s = 9e-8) to mu_2
+  // (mu_2 - mu(1e4) = 7e-6)
+  const double P0 = 1e3;
+  std::vector<double> ratios;
+  for (double I : {1e-7, 1e-3, 1.0, 1e4}) {
+    const double gdot = I * std::sqrt(P0 / p.rho_g) / p.d_m, dt = 1e-3 / gdot;
+    PointState s = dense_point(p, P0, p.phi_c, mass);
+    for (int i = 0; i < 1000; ++i) rate.update(dt, 0.0, gdot, 0.0, 0.0, mass, s);
+    ratios.push_back(tau_of(s) / s.pressure_Pa);
+    EXPECT_GT(s.strain_rate_1_s, 0.0) << "I " << I;
+    EXPECT_NEAR(ratios.back(), mu_of_I(p, mu_s, I), 1e-3 * mu_of_I(p, mu_s, I)) << "I " << I;
+  }
+  EXPECT_NEAR(ratios.front(), mu_s, 1e-3 * mu_s);
+  EXPECT_NEAR(ratios.back(), mu_2, 1e-3 * mu_2);
   // vanishing rate: identical to the rate-independent return at mu_s within round-off
   PointState a = dense_point(p, 1e3, p.phi_c, mass), b = a;
   for (int i = 0; i < 2000; ++i) {

@@ -1,6 +1,7 @@
 // Helpers for the paper-claim tests (paper_cases_test.cpp): scenes built in code (so the tests do
 // not move when someone retunes a template), runs spread over the cores one simulation per
-// thread, force traces against travel, window means and least-squares fits.
+// thread, force traces against travel and window means (the fits and claim measures:
+// paper_claims.hpp).
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -12,6 +13,7 @@
 
 #include "engine/scene.hpp"
 #include "engine/simulation.hpp"
+#include "tests/engine/paper_claims.hpp"
 #include "tests/engine/test_scenes.hpp"
 
 namespace furrow::paper {
@@ -118,30 +120,6 @@ inline std::vector<std::pair<double, double>> smoothed(const Trace& t, size_t bo
   for (double d = 0.5 * width_m; d <= t.travel_m.back() - 0.5 * width_m + 1e-12; d += every_m)
     out.emplace_back(d, window_mean(t, body, c, d - 0.5 * width_m, d + 0.5 * width_m));
   return out;
-}
-
-struct Fit {
-  double slope = 0.0, intercept = 0.0, r2 = 0.0;
-};
-
-inline Fit fit_line(const std::vector<double>& x, const std::vector<double>& y) {
-  const double n = double(x.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-  for (size_t i = 0; i < x.size(); ++i)
-    sx += x[i], sy += y[i], sxx += x[i] * x[i], sxy += x[i] * y[i], syy += y[i] * y[i];
-  const double vxx = sxx - sx * sx / n, vxy = sxy - sx * sy / n, vyy = syy - sy * sy / n;
-  Fit f;
-  f.slope = vxy / vxx;
-  f.intercept = (sy - f.slope * sx) / n;
-  f.r2 = vxy * vxy / (vxx * vyy);
-  return f;
-}
-
-// F = c L^n: slope of log F against log L.
-inline Fit fit_power_law(const std::vector<double>& x, const std::vector<double>& y) {
-  std::vector<double> lx, ly;
-  for (size_t i = 0; i < x.size(); ++i) lx.push_back(std::log(x[i])), ly.push_back(std::log(y[i]));
-  return fit_line(lx, ly);
 }
 
 }  // namespace furrow::paper

@@ -53,19 +53,23 @@ Scene cylinder_scene(double dx_m, ContactMethod contact, double depth_m, double 
   return s;
 }
 
-// The lift claim between two depths zD_a < zD_b: the lift's relative change is under half the
-// drag's (the drag still growing). Where the lift levels off the converged model reads about a
-// third (over a 20 mm drag, mean 5-20 mm: cell fraction 0.30 at 6 cells per D, 0.35 at 8; node 0.28
-// at 8), and the lift's slow wander (+-10% between 2.5 mm bins of travel) moves that by +-0.04
-// between 7.5 mm windows (0.29 / 0.32 at 6 cells, 0.37 / 0.32 at 8), so a third would split the
-// converged runs; a lift growing as the drag does reads ~1 (4 cells, 12.5-20 mm: 0.97).
-void expect_lift_levels_off(double zD_a, double zD_b, double drag_a, double drag_b, double lift_a, double lift_b) {
-  const double drag_change = drag_b / drag_a - 1, lift_change = lift_b / lift_a - 1;
-  std::printf("case 1: %g D -> %g D: drag %+.1f%%, lift %+.1f%% (%.2f of the drag's)\n", zD_a, zD_b, 100 * drag_change,
-              100 * lift_change, lift_change / drag_change);
+// The lift claim over depths zD (3 or more, increasing): the lift levels off, its growth per D
+// over the deepest interval under half its steepest growth per D before (levelling_ratio). A lift
+// growing linearly reads 1, one growing with the steepening drag above 1, and one growing +38% from
+// 10 to 15 D while the drag grows +78% reads 0.52 (PaperClaimMeasures.LevellingOffRejectsALift-
+// GrowingWithTheDrag). Until 2026-12-05 the claim was the lift's relative change under half the
+// drag's between the two deepest depths, which that +38% passed (0.49); it is still printed.
+void expect_lift_levels_off(const std::vector<double>& zD, const std::vector<double>& drag,
+                            const std::vector<double>& lift) {
+  const size_t a = zD.size() - 2, b = a + 1;
+  const double drag_change = drag[b] / drag[a] - 1, lift_change = lift[b] / lift[a] - 1;
+  const double ratio = levelling_ratio(zD, lift);
+  std::printf("case 1: %g D -> %g D: drag %+.1f%%, lift %+.1f%% (%.2f of the drag's); the lift's growth per D there "
+              "over its steepest before: %.3f\n",
+              zD[a], zD[b], 100 * drag_change, 100 * lift_change, lift_change / drag_change, ratio);
   EXPECT_GT(drag_change, 0.0);
-  EXPECT_GT(lift_a, 0.0);
-  EXPECT_LT(std::abs(lift_change), drag_change / 2.0);
+  EXPECT_GT(lift[a], 0.0);
+  EXPECT_LT(ratio, 0.5);
 }
 
 // Beds: for each depth z the smallest that does not change the drag much: 30 mm (7.5 D) of bed
@@ -98,13 +102,23 @@ TEST(PaperCase1, CylinderDragGrowsLinearlyWhileLiftLevelsOff) {
                 traces[i].wall_s);
   }
   const Fit f = fit_line(zD, drag);
-  std::printf("case 1: drag/F0 = %.3f + %.3f |z|/D, R^2 %.4f\n", f.intercept, f.slope, f.r2);
-  // resisting, growing with depth, and linear in it
+  const double curvature = secant_slope_ratio(zD, drag);
+  std::printf("case 1: drag/F0 = %.3f + %.3f |z|/D, R^2 %.4f; log-log exponent %.3f; deepest over shallowest slope %.3f "
+              "(linear 1; z^0.85 %.3f, z^1.15 %.3f; sqrt(z) %.3f, z^1.5 %.3f)\n",
+              f.intercept, f.slope, f.r2, fit_power_law(zD, drag).slope, curvature, power_law_slope_ratio(zD, 0.85),
+              power_law_slope_ratio(zD, 1.15), power_law_slope_ratio(zD, 0.5), power_law_slope_ratio(zD, 1.5));
+  // resisting and growing with depth. Linear in it, the paper's claim, does not hold here: as straight
+  // as z^(1 +- 0.15) on these depths (deepest over shallowest slope 0.83..1.20), which sqrt(z) and
+  // z^1.5 are not (PaperClaimMeasures.LinearInDepthRejectsSqrtAndThreeHalvesPowers), the drag
+  // steepens as z^1.5 does: 1.845 (2026-12-05: drag/F0 26.10 / 54.88 / 138.92 / 245.11; z^1.5 1.831),
+  // where R^2 0.990 of a straight line, the check until then, could not tell (z^1.5 reads 0.990;
+  // the lift's levelling ratio 0.400: 6.82 / 9.44 / 36.81 / 47.77 F0). So it is measured and
+  // printed, not asserted, until the solver's drag is linear (README, claims table).
   for (size_t i = 0; i < drag.size(); ++i) EXPECT_GT(drag[i], 0.0) << "|z|/D " << zD[i];
-  EXPECT_GT(f.slope, 0.0);
-  EXPECT_GE(f.r2, 0.97);
-  const size_t a = depths_m.size() - 2, b = a + 1;
-  expect_lift_levels_off(zD[a], zD[b], drag[a], drag[b], lift[a], lift[b]);
+  for (size_t i = 1; i < drag.size(); ++i) EXPECT_GT(drag[i], drag[i - 1]) << "|z|/D " << zD[i];
+  std::printf("case 1: drag linear in depth (z^(1 +- 0.15)): %s\n", linear_in_depth(zD, drag, 0.15) ? "yes" : "no");
+  // the lift levels off: its growth per D from 10 to 15 D under half its steepest before
+  expect_lift_levels_off(zD, drag, lift);
 }
 
 // The same lift claim in the paper's whole 0.20 x 0.16 m bed, cylinder from x = 0.05 m, dragged
@@ -115,25 +129,28 @@ TEST(PaperCase1, CylinderDragGrowsLinearlyWhileLiftLevelsOff) {
 // 7.16 -> 9.14 N/m (+27.6%, 0.35 of the drag's): 139 / 247 F0 and 38.4 / 49.0 F0, the compact beds'
 // 20 mm numbers within 3% (139.2 / 246.1, 38.9 / 48.0). 28 min on 2 cores, so it runs only with
 // FURROW_LONG_PAPER_TESTS=1. Node contact at 4 cells per D gave +83% / +8% here, cell fraction at 4
-// +65.8% / +48.5% (its 10 D lift is low at that dx, above).
+// +65.8% / +48.5% (its 10 D lift is low at that dx, above). Since 2026-12-05 a 5 D run gives the
+// lift's growth before it levels off (expect_lift_levels_off): three runs of ~28 min each on one core,
+// so about an hour (estimated; not yet run with it).
 TEST(PaperCase1, CylinderLiftLevelsOffInPaperBed) {
   if (!std::getenv("FURROW_LONG_PAPER_TESTS"))
-    GTEST_SKIP() << "the paper-bed check takes 28 min on 2 cores (measured: 10 D -> 15 D drag +77.9%, lift +27.6%); "
-                    "set FURROW_LONG_PAPER_TESTS=1 to run it";
+    GTEST_SKIP() << "the paper-bed check takes about an hour on 2 cores (measured: 10 D -> 15 D drag +77.9%, lift "
+                    "+27.6%); set FURROW_LONG_PAPER_TESTS=1 to run it (ctest -L paper_long)";
   const double travel = 0.02, from = 0.005;
-  const std::vector<double> depths_m = {0.040, 0.060};  // 10, 15 D
+  const std::vector<double> depths_m = {0.020, 0.040, 0.060};  // 5, 10, 15 D
   std::vector<Scene> scenes;
   for (double z : depths_m)
     scenes.push_back(cylinder_scene(kD / 6, ContactMethod::CellFraction, z, 0.05, 0.16 - z, 0.2 - 0.05 - travel, travel));
   const std::vector<Trace> traces = run_all(scenes);
-  std::vector<double> drag, lift;
+  std::vector<double> zD, drag, lift;
   for (size_t i = 0; i < depths_m.size(); ++i) {
+    zD.push_back(depths_m[i] / kD);
     drag.push_back(-window_mean(traces[i], 0, 0, from, travel));
     lift.push_back(window_mean(traces[i], 0, 1, from, travel));
     std::printf("case 1 lift: |z|/D %5.2f  drag %.2f N/m  lift %.2f N/m (%.1f s)\n", depths_m[i] / kD, drag[i], lift[i],
                 traces[i].wall_s);
   }
-  expect_lift_levels_off(depths_m[0] / kD, depths_m[1] / kD, drag[0], drag[1], lift[0], lift[1]);
+  expect_lift_levels_off(zD, drag, lift);
 }
 
 // ---- case 2: plates pushed down into the bed --------------------------------------------------
@@ -190,14 +207,17 @@ double depth_mean(const DepthTrace& d, double from_m, double to_m) {
 // (the paper's eq. 8), and the initial peak, "the force requirement for initiating media flow",
 // sits at a fixed z / L: its force ~ L^2. The solver gives no drop after that initiation at any
 // resolution tried (L/dx 8..40, with and without a velocity ramp): once smoothed over a cell the
-// trace rises monotonically, so the onset force is the mean over the same relative depths for
-// every width, z in [L/8, L/2] (the first eighth holds the contact transient and the impact's
-// elastic ringing). That F(z) does not extrapolate to zero there, a finite force starting the
-// flow (the bearing-capacity line F = rho_d g L (N_q z + N_gamma L / 2)), is checked on a line
-// fitted over the same depths. The deep force is the mean over z in [0.10, 0.14] m, 1.8..2.5
-// L_max deep, where the L^2 term falls under ~10% of the force.
+// trace rises monotonically. What is left of the claim is a finite force that starts the flow and
+// scales as L^2: the bearing-capacity line F = rho_d g L (N_q z + N_gamma L / 2), a ~ L^2 at
+// z -> 0 and b ~ L in z. Since 2026-12-05 it is tested as that: F = a + b z fitted per width over
+// one window of absolute depth, and the exponents of a and b against L (onset_scaling). Until then
+// the onset was the mean force over z in [L/8, L/2], a window that scales with L: any F = rho_d g
+// L^2 f(z / L), F = c z L included (no onset force at all), gives exponent 2 there, so it could not
+// tell the claim from its absence (PaperClaimMeasures.OnsetScalingRejectsATraceWithoutAnOnsetForce).
+// The deep force is the mean over z in [0.10, 0.14] m, 1.8..2.5 L_max deep, where the L^2 term
+// falls under ~10% of the force.
 //
-// Why a window in z / L, not the line's z -> 0 intercept (used until 2026-12-02): the intercept
+// History: a window in z / L replaced the line's z -> 0 intercept on 2026-12-02, because the intercept
 // extrapolates a trace that fluctuates by 10-20% (the node comb, the ringing), and its exponent
 // moved with everything but the physics. Measured (L = 0.04 / 0.06 / 0.08 m, E 5 MPa, intercept
 // over z in [dx, L/2] -> mean over [L/8, L/2]): dx 2.5 mm `node` 1.871 -> 1.964, `cell_fraction`
@@ -224,30 +244,49 @@ TEST(PaperCase2, SinglePlateOnsetForceScalesAsL2AndDeepForceAsL) {
   for (double L : widths_m) scenes.push_back(plates_scene(W, H, dx, L, {0.5 * W}, z_to));
   const std::vector<Trace> traces = run_all(scenes);
   const size_t n = widths_m.size();
-  std::vector<double> onset, deep;
+  // the onset: F = a + b z per width over one window of absolute depth (PaperClaimMeasures.
+  // OnsetScalingRejectsATraceWithoutAnOnsetForce: F = c z L fails it), from two cells down (the
+  // contact engages over a cell; the impact's ringing, a period of ~L / c = 1.4 ms at L_max, is
+  // gone after 0.3 mm) to L_min / 2, where the narrowest plate's run ends
+  const double window_from = 2.0 * onset_dx, window_to = 0.5 * widths_m.front();
+  std::vector<std::vector<double>> z_m(n), F_N_per_m(n);
+  std::vector<double> onset_mean, deep;
   for (size_t i = 0; i < n; ++i) {
     const double L = widths_m[i];
     const DepthTrace d = depth_trace(traces[i], 0.5 * onset_dx);
-    const double onset_from = 0.125 * L, onset_to = 0.5 * L;  // the same relative depths for every width
-    std::vector<double> zs, Fs;
-    for (size_t k = 0; k < d.z_m.size(); ++k)
-      if (d.z_m[k] >= onset_from && d.z_m[k] <= onset_to) zs.push_back(d.z_m[k]), Fs.push_back(d.F_N_per_m[k]);
-    const Fit line = fit_line(zs, Fs);
-    onset.push_back(depth_mean(d, onset_from, onset_to));
+    z_m[i] = d.z_m;
+    F_N_per_m[i] = d.F_N_per_m;
+    onset_mean.push_back(depth_mean(d, 0.125 * L, 0.5 * L));  // the measure until 2026-12-05, for the log
     deep.push_back(depth_mean(depth_trace(traces[n + i], 0.5 * dx), z_from, z_to));
-    std::printf("case 2 single: L %.3f m  onset %.1f N/m (F/(rho_d g L^2 w) %.2f; line: z -> 0 %.1f N/m, N_gamma %.2f, "
-                "slope %.0f N/m^2, N_q %.2f)  deep mean %.1f N/m (F/(rho_d g z L w) %.2f)  (%zu + %zu particles, "
-                "%.1f + %.1f s)\n",
-                L, onset.back(), onset.back() / (kRhoD * kG * L * L), line.intercept,
-                line.intercept / (0.5 * kRhoD * kG * L * L), line.slope, line.slope / (kRhoD * kG * L), deep.back(),
-                deep.back() / (kRhoD * kG * 0.5 * (z_from + z_to) * L), traces[i].particles, traces[n + i].particles,
-                traces[i].wall_s, traces[n + i].wall_s);
-    EXPECT_GT(line.intercept, 0.0) << "L " << L;
   }
-  const Fit f_onset = fit_power_law(widths_m, onset), f_deep = fit_power_law(widths_m, deep);
-  std::printf("case 2 single: exponents: onset %.3f (R^2 %.4f), deep %.3f (R^2 %.4f)\n", f_onset.slope, f_onset.r2,
-              f_deep.slope, f_deep.r2);
-  EXPECT_NEAR(f_onset.slope, 2.0, 0.3);
+  const OnsetScaling onset = onset_scaling(widths_m, z_m, F_N_per_m, window_from, window_to);
+  for (size_t i = 0; i < n; ++i) {
+    const double L = widths_m[i];
+    std::printf("case 2 single: L %.3f m  onset (F = a + b z over z %.1f-%.1f mm) a %.1f N/m (N_gamma = 2 a/(rho_d g L^2 w) "
+                "%.2f), b %.0f N/m^2 (N_q %.2f); mean over z/L 1/8..1/2 %.1f N/m  deep mean %.1f N/m "
+                "(F/(rho_d g z L w) %.2f)  (%zu + %zu particles, %.1f + %.1f s)\n",
+                L, 1e3 * window_from, 1e3 * window_to, onset.onset_N_per_m[i],
+                onset.onset_N_per_m[i] / (0.5 * kRhoD * kG * L * L), onset.slope_N_per_m2[i],
+                onset.slope_N_per_m2[i] / (kRhoD * kG * L), onset_mean[i], deep[i],
+                deep[i] / (kRhoD * kG * 0.5 * (z_from + z_to) * L), traces[i].particles, traces[n + i].particles,
+                traces[i].wall_s, traces[n + i].wall_s);
+  }
+  for (double from : {0.0075, 0.01}) {  // how the exponents move with the window's start (for the log)
+    const OnsetScaling o = onset_scaling(widths_m, z_m, F_N_per_m, from, window_to);
+    std::printf("case 2 single: window from %.1f mm: a exponent %.3f, b exponent %.3f\n", 1e3 * from, o.onset_exponent,
+                o.slope_exponent);
+  }
+  const Fit f_mean = fit_power_law(widths_m, onset_mean), f_deep = fit_power_law(widths_m, deep);
+  std::printf("case 2 single: exponents: onset force a %.3f, its growth b %.3f (mean over z/L 1/8..1/2: %.3f), deep %.3f "
+              "(R^2 %.4f)\n",
+              onset.onset_exponent, onset.slope_exponent, f_mean.slope, f_deep.slope, f_deep.r2);
+  // A finite onset force ~ L^2 (measured 2026-12-05: a 98.3 / 218.4 / 407.7 N/m, exponent 2.047).
+  // Its growth b ~ L does not hold (7574 / 10388 / 10438 N/m^2, exponent 0.48), and both move with
+  // the window's start (from 7.5 mm: 1.23 and 1.60; from 10 mm: 1.90 and 0.55): the shallow traces
+  // are not straight over 5-20 mm, so b is printed, not asserted, and the claims table says
+  // "partly holds".
+  for (size_t i = 0; i < n; ++i) EXPECT_GT(onset.onset_N_per_m[i], 0.0) << "L " << widths_m[i];
+  EXPECT_NEAR(onset.onset_exponent, 2.0, 0.3);
   EXPECT_NEAR(f_deep.slope, 1.0, 0.15);
 }
 
@@ -293,21 +332,28 @@ double pair_normalized(const Trace& t, double L, double s_over_L, DepthWindow wi
 }
 
 // Measured when chosen (L = 0.025 m): s -> inf 10.16, s = 0 10.41, s/L 0.3 12.53, s/L 0.6 12.64.
+// Those four samples rose from 0.3 to 0.6 and could not show where the peak sits; s/L 1 and 1.5
+// (since 2026-12-05) put samples past it, so the test sees a maximum with lower values on both sides
+// (PaperClaimMeasures.InteriorPeakNeedsLowerValuesPastIt: a curve still rising at 1.5 fails).
+// Measured 2026-12-05: 11.13 / 13.15 / 13.91 / 13.42 / 13.48 / 10.91 at s/L 0 / 0.3 / 0.6 / 1 / 1.5 /
+// inf: the top is broad (0.6 is 3.2-3.6% above 1 and 1.5); 71 s on 2 loaded cores.
 TEST(PaperCase2, PlatePairDragPeaksAtSmallSeparation) {
   const double L = 0.025;
-  const std::vector<double> s_over_L = {-1.0, 0.0, 0.3, 0.6};
+  const std::vector<double> s_over_L = {0.0, 0.3, 0.6, 1.0, 1.5, -1.0};  // increasing, s -> inf last
   std::vector<Scene> scenes;
   for (double r : s_over_L) scenes.push_back(pair_scene(L, r, kPeakWindow));
   const std::vector<Trace> traces = run_all(scenes);
   std::vector<double> Fn;
   for (size_t i = 0; i < s_over_L.size(); ++i) Fn.push_back(pair_normalized(traces[i], L, s_over_L[i], kPeakWindow));
-  const double far = Fn[0], touching = Fn[1];
-  const auto peak = std::max_element(Fn.begin() + 2, Fn.end());
-  std::printf("case 2 pair: peak %.2f at s/L %.2f; s = 0: %.2f (peak %+.1f%%), s -> inf: %.2f (peak %+.1f%%)\n", *peak,
-              s_over_L[size_t(peak - Fn.begin())], touching, 100 * (*peak / touching - 1), far, 100 * (*peak / far - 1));
-  // an interior maximum (0 < s/L < 1) above both ends by at least 5%
-  EXPECT_GE(*peak, 1.05 * touching);
-  EXPECT_GE(*peak, 1.05 * far);
+  size_t k = 0;
+  const bool peak = interior_peak(Fn, 0.05, &k);
+  const double touching = Fn.front(), far = Fn.back();
+  std::printf("case 2 pair: peak %.2f at s/L %.2f; s = 0: %.2f (peak %+.1f%%), s -> inf: %.2f (peak %+.1f%%), "
+              "largest finite s/L %.1f: %.2f (peak %+.1f%%)\n",
+              Fn[k], s_over_L[k], touching, 100 * (Fn[k] / touching - 1), far, 100 * (Fn[k] / far - 1),
+              s_over_L[s_over_L.size() - 2], Fn[Fn.size() - 2], 100 * (Fn[k] / Fn[Fn.size() - 2] - 1));
+  // an interior maximum (0 < s/L < 1.5) above both ends by at least 5%, lower past it
+  EXPECT_TRUE(peak) << "largest at s/L " << (s_over_L[k] < 0 ? "inf" : std::to_string(s_over_L[k]));
 }
 
 // The same claim where a user first looks: the two_plates template at its preview dx (10 mm, 10

@@ -119,6 +119,7 @@ int main(int argc, char** argv) {
   std::mt19937_64 rng(20240611);
   long clean = 0, rejected = 0, failures = 0;
   double slowest_ms = 0.0;
+  long slowest_it = -1;
   const auto t0 = std::chrono::steady_clock::now();
   for (long it = 0; it < iterations; ++it) {
     const auto& [name, text] = seeds[size_t(it) % seeds.size()];
@@ -145,17 +146,15 @@ int main(int argc, char** argv) {
       std::cerr << "iteration " << it << " (" << name << "): unexpected exception: " << e.what() << "\n";
       ++failures;
     }
+    // reported, not asserted: a wall-clock bound fails on a loaded machine; an input that hangs the
+    // reader is caught by the CTest timeout of the whole run (CMakeLists.txt)
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    slowest_ms = std::max(slowest_ms, ms);
-    if (ms > 2000.0) {
-      std::cerr << "iteration " << it << " (" << name << ") took " << ms << " ms\n";
-      ++failures;
-    }
+    if (ms > slowest_ms) slowest_ms = ms, slowest_it = it;
   }
   const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << iterations << " mutations of " << seeds.size() << " templates: " << clean << " parsed, "
             << rejected << " rejected with SceneError, " << failures << " failures; slowest "
-            << slowest_ms << " ms, total " << total_s << " s\n";
+            << slowest_ms << " ms (iteration " << slowest_it << "), total " << total_s << " s\n";
   // both outcomes must occur, or the mutations are too weak (or too strong) to test anything
   if (clean == 0 || rejected == 0) {
     std::cerr << "degenerate fuzz run: every input had the same outcome\n";

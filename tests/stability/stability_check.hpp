@@ -94,6 +94,28 @@ inline std::array<long double, 2> mass_moment(const Particles& p) {
   return {sx, sy};
 }
 
+// How much of its weight the material carries as stress, resting on the floor at y = 0: the
+// vertical virial -sum_p V_p sigma_yy over the weight's moment about the floor g sum_p m_p y_p. At
+// rest the two are equal in the continuum (the integral of sigma_yy is that of y times the body
+// force; the floor's reaction acts at y = 0, free surfaces carry nothing), so this reads 1; a heap
+// of stress-free points reads 0. On the grid the identity is exact (the B-splines reproduce y)
+// except that nodes one cell below the floor line take part of the reaction too, which adds up to
+// dx / y_m of it, y_m = sum m y / sum m (floor_reaction_excess_bound).
+inline double weight_carried_fraction(const Particles& p, double g_m_s2) {
+  long double virial = 0.0L, moment = 0.0L;
+  for (size_t i = 0; i < p.size(); ++i) {
+    virial += (long double)p.volume[i] * (double(p.pressure[i]) - double(p.syy[i]));
+    moment += (long double)p.mass[i] * g_m_s2 * p.y[i];
+  }
+  return double(virial / moment);
+}
+
+inline double floor_reaction_excess_bound(const Particles& p, double dx_m) {
+  long double my = 0.0L, m = 0.0L;
+  for (size_t i = 0; i < p.size(); ++i) my += (long double)p.mass[i] * p.y[i], m += p.mass[i];
+  return dx_m / double(my / m);
+}
+
 inline long double mass_sum(const Particles& p) {
   long double m = 0.0L;
   for (double mi : p.mass) m += mi;
