@@ -1759,9 +1759,16 @@ struct Reader {
 
 }  // namespace
 
-void Simulation::save_state(std::ostream& out) const {
+struct BodyStateV3 {  // a body's record before bodies could turn (checkpoint versions 1 to 3)
+  Vec2 position_m, velocity_m_s, force_N_per_m, lo_m, hi_m;
+};
+
+void Simulation::save_state(std::ostream& out, uint32_t version) const {
+  if (version == 0) version = kCheckpointVersion;
+  if (version < 2 || version > kCheckpointVersion)
+    throw std::invalid_argument("save_state: writes versions 2 to " + std::to_string(kCheckpointVersion));
   out.write(kCheckpointMagic, sizeof kCheckpointMagic);
-  put(out, kCheckpointVersion);
+  put(out, version);
   put(out, uint64_t(p_.size()));
   p_.for_each_array([&](const char* name, const auto& a) {
     put(out, uint32_t(sizeof(a[0])));
@@ -1770,12 +1777,20 @@ void Simulation::save_state(std::ostream& out) const {
     put_vector(out, a);
   });
   put(out, t_s_), put(out, dt_s_), put(out, steps_), put(out, stats_), put(out, phase_s_), put(out, wall_forces_);
-  put_vector(out, bodies_);
+  if (version >= 4) {
+    put_vector(out, bodies_);
+  } else {
+    std::vector<BodyStateV3> old;
+    for (const BodyState& b : bodies_) old.push_back({b.position_m, b.velocity_m_s, b.force_N_per_m, b.lo_m, b.hi_m});
+    put_vector(out, old);
+  }
   put(out, uint64_t(touched_.size()));
   for (const auto& t : touched_) put_vector(out, t);
   put_vector(out, contacts_);
-  put_vector(out, strip_start_);
-  put(out, reorders_);
+  if (version >= 3) {
+    put_vector(out, strip_start_);
+    put(out, reorders_);
+  }
 }
 
 void Simulation::load_state(std::istream& in, const std::string& what) {
@@ -1806,9 +1821,6 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
   if (version >= 4) {
     r.get_vector(bodies_, "bodies", bodies_.size());
   } else {
-    struct BodyStateV3 {
-      Vec2 position_m, velocity_m_s, force_N_per_m, lo_m, hi_m;
-    };
     std::vector<BodyStateV3> old;
     r.get_vector(old, "bodies", bodies_.size());
     for (size_t b = 0; b < old.size(); ++b) {

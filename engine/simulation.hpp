@@ -198,7 +198,9 @@ class Simulation {
   // time, the dt limiter's last speed, contact warm starts and marks), so a simulation built from
   // the same scene and loaded continues bit-identically. load_state throws std::runtime_error
   // naming `what` when the stream is not a checkpoint of this build and scene size.
-  void save_state(std::ostream& out) const;
+  // `version` below the current writes an older layout (2: no strip ranges; 3: bodies without
+  // angles), for the tests that check old checkpoints are still read
+  void save_state(std::ostream& out, uint32_t version = 0) const;
   void load_state(std::istream& in, const std::string& what);
 
   // diagnostics
