@@ -251,7 +251,7 @@ class Simulation {
   Particles p_;
   Grid g_;
   std::vector<BodyState> bodies_;
-  std::array<Vec2, 4> wall_forces_{};
+  std::array<Vec2, 4> wall_forces_{Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero()};  // Eigen does not zero on {}
   std::vector<MaterialParams> materials_;
   double t_s_ = 0.0, dt_s_ = 0.0, wave_speed_ = 0.0;
   int64_t steps_ = 0;
