@@ -2,6 +2,7 @@
 // and all threads, stored for validate/run/study to predict wall times.
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,16 +54,16 @@ Scene bench_scene(ShapeFunction shape, bool dpm, int threads, double dx_m = 0.00
   return s;
 }
 
-// Particle-steps per wall second over at least `seconds` and 20 steps, after 10 steps of warm-up;
+// Particle-steps per wall second over at least `seconds` and `min_steps` steps, after 10 steps of warm-up;
 // *phases: the phase seconds of the measured steps.
-double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases) {
+double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases, int64_t min_steps = 20) {
   for (int i = 0; i < 10; ++i) sim.step();  // first touches of memory and contact warm-up
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const PhaseSeconds before = sim.phase_seconds();
   int64_t steps = 0;
   double elapsed = 0.0;
-  while (steps < 20 || elapsed < seconds) {
+  while (steps < min_steps || elapsed < seconds) {
     sim.step();
     ++steps;
     elapsed = std::chrono::duration<double>(clock::now() - t0).count();
@@ -76,8 +77,91 @@ double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases) {
   return double(steps) * double(sim.particles().size()) / elapsed;
 }
 
+// "1,2,4" -> {1, 2, 4}; anything else is a usage error naming the option.
+std::vector<int> parse_thread_list(const std::string& text) {
+  std::vector<int> out;
+  size_t at = 0;
+  while (at <= text.size()) {
+    const size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    char* end = nullptr;
+    const long n = std::strtol(item.c_str(), &end, 10);
+    if (item.empty() || *end != '\0' || n < 1 || n > 4096)
+      throw UsageError("--threads " + text + ": expected a comma-separated list of thread counts, each 1 to 4096 (e.g. 1,2,4)");
+    out.push_back(int(n));
+    at = comma + 1;
+  }
+  return out;
+}
+
+// `--threads LIST`: where a step stops scaling. The bench scene (quadratic NDPM) for a fixed number of
+// steps on each thread count, best of `repeats` runs by total time; prints each phase's seconds and
+// its speedup over the first count. Writes no calibration.
+int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps, int repeats) {
+  struct Row {
+    int threads;
+    double rate;
+    PhaseSeconds ph;
+  };
+  std::vector<Row> rows;
+  size_t particles = 0;
+  for (int threads : thread_counts) {
+    Row best{threads, 0.0, {}};
+    for (int r = 0; r < repeats; ++r) {
+      Simulation sim(bench_scene(ShapeFunction::Quadratic, false, threads, dx_m));
+      particles = sim.particles().size();
+      PhaseSeconds ph;
+      const double rate = measure_rate(sim, 0.0, &ph, steps);
+      if (rate > best.rate) best = {threads, rate, ph};
+    }
+    rows.push_back(best);
+  }
+  std::printf("plate_intrusion at dx %.4g m, %zu particles, quadratic NDPM, %d steps after 10, best of %d\n", dx_m,
+              particles, steps, repeats);
+  std::printf("wall seconds per phase over the steps, and (in brackets) the speedup over %d thread%s\n",
+              rows.front().threads, rows.front().threads == 1 ? "" : "s");
+  const char* names[] = {"clear", "p2g", "grid", "contact", "g2p+const", "reorder", "step"};
+  auto phases = [](const PhaseSeconds& ph) {
+    return std::array<double, 7>{ph.clear, ph.p2g,     ph.grid,      ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,
+                                 ph.reorder, ph.total()};
+  };
+  std::printf("%7s %19s", "threads", "M particle-steps/s");
+  for (const char* n : names) std::printf(" %17s", n);
+  std::printf("\n");
+  const auto base = phases(rows.front().ph);
+  for (const Row& row : rows) {
+    std::printf("%7d %19.2f", row.threads, row.rate / 1e6);
+    const auto now = phases(row.ph);
+    for (size_t k = 0; k < now.size(); ++k) {
+      char cell[32];
+      if (now[k] > 0.0 && base[k] > 0.0)
+        std::snprintf(cell, sizeof cell, "%.4f (%.2fx)", now[k], base[k] / now[k]);
+      else
+        std::snprintf(cell, sizeof cell, "%.4f (-)", now[k]);  // a phase that did not run (reorder in few steps)
+      std::printf(" %17s", cell);
+    }
+    std::printf("\n");
+  }
+  std::printf("share of a %d-thread step:", rows.front().threads);
+  for (size_t k = 0; k + 1 < base.size(); ++k) std::printf(" %s %.1f%%", names[k], 100.0 * base[k] / base.back());
+  std::printf("\n");
+  return 0;
+}
+
 int bench_main(const Parsed& p) {
   char* end = nullptr;
+  if (p.has("--threads")) {
+    const std::vector<int> counts = parse_thread_list(p.get("--threads"));
+    const std::string dx_text = p.get("--dx", "0.005"), steps_text = p.get("--steps", "300");
+    const double dx_m = std::strtod(dx_text.c_str(), &end);
+    if (dx_text.empty() || *end != '\0' || !(dx_m >= 0.0005) || dx_m > 0.02)
+      throw UsageError("--dx " + dx_text + ": expected a grid spacing in metres in [0.0005, 0.02]");
+    const long steps = std::strtol(steps_text.c_str(), &end, 10);
+    if (steps_text.empty() || *end != '\0' || steps < 1 || steps > 1000000)
+      throw UsageError("--steps " + steps_text + ": expected a number of steps from 1 to 1000000");
+    return bench_scaling(counts, dx_m, int(steps), 2);
+  }
+  if (p.has("--dx") || p.has("--steps")) throw UsageError("--dx and --steps go with --threads (the scaling table)");
   const std::string sec_text = p.get("--seconds", "2");
   const double seconds = std::strtod(sec_text.c_str(), &end);
   if (sec_text.empty() || *end != '\0' || !(seconds > 0.0) || seconds > 600.0)
@@ -143,7 +227,7 @@ int bench_main(const Parsed& p) {
 Command command_bench() {
   return {"bench",
           "measure this machine's solver speed so validate, run and study can predict wall times",
-          "furrow bench [--seconds S] [--out FILE]",
+          "furrow bench [--seconds S] [--out FILE]\n       furrow bench --threads 1,2,4,... [--dx M] [--steps N]",
           "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
           "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
@@ -154,10 +238,17 @@ Command command_bench() {
           "else ~/.config/furrow/calibration.json). `furrow validate` then prints a scene's predicted\n"
           "solver time, `furrow run` compares against it, and `furrow study` predicts its first rung.\n"
           "About 13 x (S + setup) seconds (under a minute at the default S); the machine should be\n"
-          "otherwise idle for figures that hold.",
+          "otherwise idle for figures that hold.\n\n"
+          "With --threads LIST it measures where a step stops scaling instead: quadratic NDPM on the same\n"
+          "scene (dx M, default 0.005 m) for N steps (default 300) after 10 of warm-up on each thread count,\n"
+          "best of two runs each, and prints the wall seconds of each phase with its speedup over the\n"
+          "first count. Nothing is stored.",
           {{"--seconds", true, false, "seconds per measurement (default 2)", "S"},
            {"--out", true, false, "calibration file to write (replaced)", "FILE"},
-           {"--quiet", false, false, "no header line on stderr"}},
+           {"--quiet", false, false, "no header line on stderr"},
+           {"--threads", true, false, "per-phase scaling over these thread counts (e.g. 1,2,4); stores nothing", "LIST"},
+           {"--dx", true, false, "with --threads: grid spacing of the scene in m (default 0.005)", "M"},
+           {"--steps", true, false, "with --threads: steps measured per run (default 300)", "N"}},
           0,
           0,
           bench_main};

@@ -28,6 +28,9 @@ namespace furrow {
 namespace {
 
 constexpr size_t kGrain = 4096;  // particles per TBB task
+// grid nodes per task of the grid passes (clear, grid update): 2048 x 40 B = 80 kB, so the 34k nodes
+// of the bench bed (dx 5 mm) make 17 tasks; at 16384 they made 3, two threads split them 2:1
+constexpr size_t kGridGrain = 2048;
 // particles G2P and the constitutive update take in turn when fused: their ~20 arrays of a block
 // stay in L2 (256 points x 20 x 8 B = 40 kB). Measured alone this gains nothing (README,
 // Performance); it is the shape a fused G2P + constitutive + next P2G pass would take.
@@ -468,7 +471,7 @@ double Simulation::lead_body_travel_m() const {
 }
 
 void Simulation::clear_grid() {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), 1 << 14), [&](const auto& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), kGridGrain), [&](const auto& r) {
     std::fill(g_.node.begin() + r.begin(), g_.node.begin() + r.end(), GridNode{});
   });
 }
@@ -671,7 +674,7 @@ void Simulation::p2g_strip_quadratic_by_four(int strip) {
 void Simulation::grid_update() {
   const double dt = dt_s_, gx = gravity_.x() * dt, gy = gravity_.y() * dt;
   const bool flip = flip_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), 1 << 14), [&](const auto& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), kGridGrain), [&](const auto& r) {
     for (size_t k = r.begin(); k < r.end(); ++k) {
       GridNode& n = g_.node[k];
       if (n.m > 0.0) {
@@ -835,56 +838,76 @@ void Simulation::contact_cell_fraction() {
     m_points.assign(box_nodes, 0.0);
     const bool free = scene_.bodies[b].dynamics.any_free();
     if (free) stencil_nn_[b].assign(box_nodes, Vec3(0.0, 0.0, 0.0));
+    // Both sums below run over bands of the box's node rows in parallel. Each band visits every
+    // sample and point in the same order as one pass would and adds only to its own rows, so each
+    // node's sum is the same whatever the bands: results are the same for any thread count (a
+    // point whose stencil spans two bands is worked out in both). Two bands per thread for balance,
+    // each at least four rows high; on one thread, one band and no work twice.
+    const int rows = j1 - j0 + 1, threads = tbb::this_task_arena::max_concurrency();
+    const int bands = threads == 1 ? 1 : std::clamp(std::min(rows / 4, 2 * threads), 1, rows);
+    auto band_rows = [&](int band) {
+      return std::pair<int, int>(j0 + int(int64_t(rows) * band / bands), j0 + int(int64_t(rows) * (band + 1) / bands) - 1);
+    };
     // the body's field over its node box
     auto& field = body_node_mass_kg_[b];
     field.assign(box_nodes, 0.0);
-    for (const Vec2& q : body_samples_m_[b]) {
-      const Vec2 x = s.position_m + s.to_world(q);
-      double wx[K::N], wy[K::N], dw[K::N];
-      const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
-      const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
-      for (int j = std::max(by, j0); j <= std::min(by + K::N - 1, j1); ++j)
-        for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i)
-          field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
-    }
+    tbb::parallel_for(0, bands, [&](int band) {
+      const auto [ra, rb] = band_rows(band);
+      for (const Vec2& q : body_samples_m_[b]) {
+        const Vec2 x = s.position_m + s.to_world(q);
+        const int base_y = K::base(x.y() * inv_dx);
+        if (base_y > rb || base_y + K::N - 1 < ra) continue;
+        double wx[K::N], wy[K::N], dw[K::N];
+        const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
+        const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
+        for (int j = std::max(by, ra); j <= std::min(by + K::N - 1, rb); ++j)
+          for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i)
+            field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
+      }
+    });
     // each point in reach: marks its stencil if it touches the body, and adds to each node of its
     // stencil (weight x mass) the change that holds the node against the body along the point's
-    // own face normal; points in strip order, so the sums are the same for any thread count. Only
-    // nodes the body's field reaches: contact_nodes() acts on no other (and clears their marks).
+    // own face normal; points in strip order. Only nodes the body's field reaches: contact_nodes()
+    // acts on no other (and clears their marks).
     const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
-    for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
-      const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
-      if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
-          r.y() > s.hi_m.y() + reach)
-        continue;
-      const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
-      double wx[K::N], wy[K::N], dw[K::N];
-      const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
-      const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
-      const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
-      const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
-      bool reached = false;
-      for (int j = ja; j <= jb; ++j)
-        for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
-      if (!reached) continue;
-      const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
-      const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
-      const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
-      const double mass = double(p_.mass[p]);
-      for (int j = ja; j <= jb; ++j)
-        for (int i = ia; i <= ib; ++i) {
-          const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
-          if (field[c] <= 0.0) continue;
-          if (touching) touched[k] = 1;
-          const double wm = wx[i - bx] * wy[j - by] * mass;
-          m_points[c] += wm;
-          Vec2 v(g_.node[k].vx, g_.node[k].vy);
-          const Vec2 v0 = v;
-          if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
-          dv[c] += wm * (v - v0);
-          if (free) stencil_nn_[b][c] += wm * nn;
-        }
-    }
+    tbb::parallel_for(0, bands, [&](int band) {
+      const auto [ra, rb] = band_rows(band);
+      for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
+        const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
+        if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
+            r.y() > s.hi_m.y() + reach)
+          continue;
+        const int base_y = K::base(p_.y[p] * inv_dx);
+        if (base_y > rb || base_y + K::N - 1 < ra) continue;
+        double wx[K::N], wy[K::N], dw[K::N];
+        const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
+        const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
+        const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
+        const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
+        bool reached = false;  // over the whole stencil, not only this band's rows
+        for (int j = ja; j <= jb; ++j)
+          for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
+        if (!reached) continue;
+        const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
+        const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
+        const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
+        const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
+        const double mass = double(p_.mass[p]);
+        for (int j = std::max(ja, ra); j <= std::min(jb, rb); ++j)
+          for (int i = ia; i <= ib; ++i) {
+            const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
+            if (field[c] <= 0.0) continue;
+            if (touching) touched[k] = 1;
+            const double wm = wx[i - bx] * wy[j - by] * mass;
+            m_points[c] += wm;
+            Vec2 v(g_.node[k].vx, g_.node[k].vy);
+            const Vec2 v0 = v;
+            if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
+            dv[c] += wm * (v - v0);
+            if (free) stencil_nn_[b][c] += wm * nn;
+          }
+      }
+    });
   }
   contact_nodes<true>();
 }

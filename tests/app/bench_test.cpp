@@ -130,3 +130,57 @@ TEST_F(BenchCli, BenchStoresAFigureForEveryShapeFunctionModelAndThreadCount) {
 }
 
 }  // namespace
+
+namespace {
+
+// `furrow bench --threads`: a row per thread count, each phase's seconds adding up to the step's,
+// each bracketed speedup the first row's seconds over the row's, and no calibration written.
+TEST_F(BenchCli, ScalingTableHasARowPerThreadCountWhosePhasesAddUpToTheStep) {
+  const auto r = run({"bench", "--threads", "1,3", "--dx", "0.01", "--steps", "5"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::regex row(R"(^ *([0-9]+) +([0-9.]+)((?: +[0-9.]+ \((?:[0-9.]+x|-)\)){7}) *$)");
+  const std::regex cell(R"(([0-9.]+) \(([0-9.]+x|-)\))");  // "-": the phase did not run
+  std::vector<int> threads;
+  std::vector<std::vector<std::pair<double, double>>> cells;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (!std::regex_match(line, m, row)) continue;
+    threads.push_back(std::stoi(m[1]));
+    EXPECT_GT(std::stod(m[2]), 0.0) << line;
+    const std::string rest = m[3];
+    cells.emplace_back();
+    for (std::sregex_iterator it(rest.begin(), rest.end(), cell), end; it != end; ++it)
+      cells.back().emplace_back(std::stod((*it)[1]), (*it)[2] == "-" ? NAN : std::stod((*it)[2]));
+  }
+  ASSERT_EQ(threads, (std::vector<int>{1, 3})) << r.out;
+  for (const auto& c : cells) {
+    double phases = 0.0;
+    for (size_t k = 0; k + 1 < c.size(); ++k) phases += c[k].first;
+    EXPECT_NEAR(phases, c.back().first, 6 * 0.00005 + 1e-9) << r.out;  // six phases printed to 4 decimals
+    EXPECT_GT(c.back().first, 0.0);
+  }
+  for (size_t k = 0; k < cells[0].size(); ++k) {
+    if (std::isnan(cells[0][k].second) || std::isnan(cells[1][k].second)) {  // only a phase with no time
+      EXPECT_TRUE(cells[0][k].first == 0.0 || cells[1][k].first == 0.0) << r.out;
+      continue;
+    }
+    EXPECT_DOUBLE_EQ(cells[0][k].second, 1.0);
+    if (cells[1][k].first >= 0.001)  // large enough for the printed digits to give the ratio to ~10%
+      EXPECT_NEAR(cells[1][k].second, cells[0][k].first / cells[1][k].first,
+                  0.1 * cells[0][k].first / cells[1][k].first + 0.01)
+          << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("calibration.json")));
+  // a list that is not one, and the scaling options without --threads, are refused by name
+  for (const std::vector<std::string>& bad : {std::vector<std::string>{"bench", "--threads", "1,,2"},
+                                              std::vector<std::string>{"bench", "--threads", "0"},
+                                              std::vector<std::string>{"bench", "--threads", "2", "--dx", "-1"},
+                                              std::vector<std::string>{"bench", "--steps", "10"}}) {
+    const auto b = run(bad);
+    EXPECT_EQ(b.status, 2) << bad[2];
+    EXPECT_NE(b.err.find(bad[bad.size() - 2]), std::string::npos) << b.err;
+  }
+}
+
+}  // namespace
