@@ -10,10 +10,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 #include "app/calibration.hpp"
 #include "app/commands.hpp"
@@ -140,9 +142,9 @@ py::tuple run(const PyScene& s, const std::string& out_dir, bool force, bool par
 }
 
 // `furrow sweep` / `furrow study` with the command line `args` (after the command name), run by the
-// CLI's own driver with the GIL released. Python is asked about Ctrl-C at most every 0.1 s (a GIL
-// round trip per step would slow the runs whenever another thread holds it); `progress(dict)` gets
-// the driver's events and its runs' progress. Returns (exit status, what the driver wrote as
+// CLI's own driver on a thread of its own: a sweep's runs go on worker threads, where Python sees no
+// signals, so the calling thread waits and asks Python about Ctrl-C every 0.1 s. `progress(dict)`
+// gets the driver's events and its runs' progress. Returns (exit status, what the driver wrote as
 // errors, the exception that stopped it or None).
 py::tuple drive(const std::string& command, const std::vector<std::string>& args, py::object progress,
                 double progress_interval_s, const std::string& furrow_exe) {
@@ -156,8 +158,6 @@ py::tuple drive(const std::string& command, const std::vector<std::string>& args
   hooks.run_progress_interval_s = progress_interval_s;
   std::atomic<bool> stop{false};
   std::optional<py::object> error;  // touched with the GIL held only
-  std::mutex poll_mutex;
-  auto last_poll = std::chrono::steady_clock::now();
   // with the GIL held: run `f`, turning a Python exception into a stop
   auto guarded = [&](auto&& f) {
     if (error) return;
@@ -168,20 +168,7 @@ py::tuple drive(const std::string& command, const std::vector<std::string>& args
       stop = true;
     }
   };
-  hooks.stop_requested = [&] {
-    if (stop) return true;
-    {
-      std::lock_guard<std::mutex> lock(poll_mutex);
-      const auto now = std::chrono::steady_clock::now();
-      if (now - last_poll < std::chrono::milliseconds(100)) return false;
-      last_poll = now;
-    }
-    py::gil_scoped_acquire gil;
-    guarded([] {
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    });
-    return stop.load();
-  };
+  hooks.stop_requested = [&] { return stop.load(); };
   if (!progress.is_none()) {
     hooks.on_event = [&](const nlohmann::json& e) {
       py::gil_scoped_acquire gil;
@@ -198,10 +185,32 @@ py::tuple drive(const std::string& command, const std::vector<std::string>& args
     };
   }
   int status = 0;
-  {
-    py::gil_scoped_release released;
-    status = command == "sweep" ? cli::sweep_main(parsed, hooks) : cli::study_main(parsed, hooks);
+  std::exception_ptr failure;
+  std::mutex m;
+  std::condition_variable finished;
+  bool done = false;
+  std::thread driver([&] {
+    try {
+      status = command == "sweep" ? cli::sweep_main(parsed, hooks) : cli::study_main(parsed, hooks);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(m);
+    done = true;
+    finished.notify_all();
+  });
+  for (bool over = false; !over;) {
+    {
+      py::gil_scoped_release released;
+      std::unique_lock<std::mutex> lock(m);
+      over = finished.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; });
+    }
+    guarded([] {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    });
   }
+  driver.join();
+  if (failure) std::rethrow_exception(failure);
   return py::make_tuple(status, err.str(), error ? *error : py::object(py::none()));
 }
 

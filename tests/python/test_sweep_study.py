@@ -2,12 +2,14 @@
 # same run directories and the same tables as `furrow sweep` / `furrow study`, cell for cell apart
 # from the columns that measure the machine (wall time, peak memory).
 import csv
+import json
+import signal
 
 import numpy as np
 import pytest
 
 import furrow
-from conftest import cli
+from conftest import cli, python
 
 DX_M = ["0.02", "0.01"]  # two cheap rungs of the small plate
 MACHINE_COLUMNS = {"wall_s", "predicted_wall_s", "peak_memory_MB"}
@@ -75,3 +77,26 @@ def test_a_bad_vary_key_raises_with_its_json_path(small_plate_file, tmp_path):
         furrow.sweep(small_plate_file, vary=["domain.dx_m=0.02:0.01"], out=tmp_path / "bad")
     with pytest.raises(ValueError, match="quantity"):
         furrow.study(small_plate_file, ladder={"domain.dx_m": [0.02, 0.01]}, out=tmp_path / "bad", quantity="nope")
+
+
+def test_ctrl_c_stops_a_sweep_with_checkpoints(small_plate_file, tmp_path):
+    out = tmp_path / "sweep"
+    p = python(f"import furrow\n"
+               f"def progress(e):\n"
+               f"    if e['event'] == 'run_progress': print('running', flush=True)\n"
+               f"try:\n"
+               f"    furrow.sweep(r'{small_plate_file}', vary={{'domain.dx_m': [0.02, 0.01]}}, out=r'{out}',\n"
+               f"                 set={{'solver.end_time_s': 1.5, 'solver.end_displacement_m': None}},\n"
+               f"                 progress=progress, progress_interval_s=0.05)\n"
+               f"except KeyboardInterrupt as e:\n"
+               f"    print('interrupted', e)\n")
+    line = p.stdout.readline().strip()
+    assert line == "running", p.communicate()[1]  # a run is in the solver's loop
+    p.send_signal(signal.SIGINT)
+    stdout, stderr = p.communicate(timeout=120)
+    assert p.returncode == 0, stderr
+    assert any(l.startswith("interrupted furrow sweep stopped") for l in stdout.splitlines()), stdout
+    runs = json.loads((out / "sweep.json").read_text())["runs"]
+    assert {r["status"] for r in runs} <= {"stopped", "ok"} and "stopped" in {r["status"] for r in runs}
+    assert not (out / "sweep.csv").exists()
+    assert any((out / (r["dir"] + ".partial-" + str(p.pid)) / "checkpoint").is_dir() for r in runs)
