@@ -390,7 +390,7 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job, const DriverHook
   std::printf("sweep of %zu runs (%zu reused, %zu failed) in %s: %s/sweep.csv%s%s%s\n", rows.size(), reused, failed,
               format_duration(total).c_str(), plan.out_dir.string().c_str(), plotted ? " and sweep.png (" : "",
               plotted ? figure.kind.c_str() : "", plotted ? ")" : "");
-  if (failed && !quiet) {
+  if (failed) {
     std::fprintf(stderr, "furrow sweep: %zu of %zu runs failed (status and error in sweep.csv):\n", failed, rows.size());
     for (const auto& r : rows)
       if (!r.ok) std::fprintf(stderr, "  %s: %s\n", r.dir.c_str(), r.error.c_str());
