@@ -1,6 +1,8 @@
 // furrow study: one scene over a ladder of settings, each rung a child `furrow run` (so its peak
 // memory is its own and a crash or Ctrl-C loses only that rung), cheapest first, with the wall time
-// of each rung predicted from the finished ones; the table is rewritten after every rung.
+// of each rung predicted from the finished ones; the table is rewritten after every rung. In the app
+// core: the Python module's furrow.study runs this same driver (app/drivers.hpp), its rungs runs of
+// the furrow CLI.
 #include <signal.h>
 #include <fcntl.h>
 #include <spawn.h>
@@ -21,6 +23,7 @@
 
 #include "app/calibration.hpp"
 #include "app/commands.hpp"
+#include "app/drivers.hpp"
 #include "app/progress.hpp"
 #include "app/run_dirs.hpp"
 #include "app/study.hpp"
@@ -49,7 +52,10 @@ struct Job {
   std::chrono::steady_clock::time_point start;
 };
 
-int study_main(const Parsed& p) {
+}  // namespace
+
+int study_main(const Parsed& p, const DriverHooks& hooks) {
+  std::ostream& err = hooks.err ? *hooks.err : std::cerr;
   const std::string scene_path = p.positional[0];
   const bool quiet = p.has("--quiet");
 
@@ -72,13 +78,14 @@ int study_main(const Parsed& p) {
     base = load_scene_for_cli(p, scene_path);
     for (const auto& c : combos) scenes.push_back(load_varied_scene(p, scene_path, ladders, c, "--ladder"));
   } catch (const SceneError& e) {
-    std::cerr << "furrow study: " << e.what() << "\n";
+    if (hooks.throw_scene_errors) throw;
+    err << "furrow study: " << e.what() << "\n";
     return 1;
   }
   for (size_t r = 0; r < scenes.size(); ++r) {
     const std::string why = study::cannot_produce(scenes[r], q, body);
     if (!why.empty()) {
-      std::cerr << "furrow study: --quantity " << study::quantity_name(q) << ": " << scene_path << " cannot produce it"
+      err << "furrow study: --quantity " << study::quantity_name(q) << ": " << scene_path << " cannot produce it"
                 << (scenes.size() > 1 && r > 0 ? " (rung " + std::to_string(r + 1) + ")" : "") << ": " << why << "\n";
       return 1;
     }
@@ -116,9 +123,9 @@ int study_main(const Parsed& p) {
       fs::remove_all(out_dir / rungs[r].dir);  // an incomplete rung directory holds no finished result
   }
   if (!conflicts.empty()) {
-    std::cerr << "furrow study: " << out_dir.string() << " holds runs that are not this study's rungs:\n";
-    for (const auto& c : conflicts) std::cerr << "  " << c << "\n";
-    std::cerr << "pass --out DIR for a new study\n";
+    err << "furrow study: " << out_dir.string() << " holds runs that are not this study's rungs:\n";
+    for (const auto& c : conflicts) err << "  " << c << "\n";
+    err << "pass --out DIR for a new study\n";
     return 1;
   }
 
@@ -160,7 +167,7 @@ int study_main(const Parsed& p) {
         collect(r);
         ++reused;
       } catch (const std::exception& e) {
-        std::cerr << "furrow study: " << (out_dir / rungs[r].dir).string() << ": cannot read its results: " << e.what()
+        err << "furrow study: " << (out_dir / rungs[r].dir).string() << ": cannot read its results: " << e.what()
                   << "\npass --out DIR for a new study\n";
         return 1;
       }
@@ -195,11 +202,11 @@ int study_main(const Parsed& p) {
                             {"wall_s", g.ok ? num(g.wall_s) : nlohmann::json(nullptr)},
                             {"estimated_particle_steps", g.estimated_particle_steps}});
     write_file_atomic((out_dir / "study.json").string(), j.dump(2) + "\n");
-    if (final_figure) try {
-        render::write_figure_png(study::study_figure(base.name, q, copy, s), (out_dir / "study.png").string(), true);
+    if (final_figure && hooks.write_figure_png) try {
+        hooks.write_figure_png(study::study_figure(base.name, q, copy, s), (out_dir / "study.png").string());
         plotted = true;
       } catch (const std::exception& e) {
-        std::cerr << "furrow study: warning: no study.png: " << e.what() << "\n";
+        err << "furrow study: warning: no study.png: " << e.what() << "\n";
       }
     return std::make_pair(copy, s);
   };
@@ -221,19 +228,23 @@ int study_main(const Parsed& p) {
   }
   write_outputs(false);
 
-  const std::string exe = fs::read_symlink("/proc/self/exe").string();
-  struct sigaction sa {};
-  sa.sa_handler = on_stop;
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGINT, &sa, nullptr);
+  const std::string exe = hooks.furrow_exe.empty() ? fs::read_symlink("/proc/self/exe").string() : hooks.furrow_exe;
+  g_stop = 0;
+  if (!hooks.stop_requested) {  // the CLI: a signal stops the study; the module polls Python instead
+    struct sigaction sa {};
+    sa.sa_handler = on_stop;
+    sigaction(SIGTERM, &sa, nullptr);
+    sigaction(SIGINT, &sa, nullptr);
+  }
+  auto stop = [&] { return g_stop || (hooks.stop_requested && hooks.stop_requested() && (g_stop = 1)); };
   const auto calibration = load_calibration();  // predicts the first rung, when there is one
   std::map<pid_t, Job> running;
   size_t next = 0, finished = reused, failed = 0;
   const long long sigterm_after = sigterm_self_at("FURROW_SIGTERM_AFTER_RUNGS");
   long long finished_here = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  while ((next < order.size() || !running.empty()) && !g_stop) {
-    while (next < order.size() && int(running.size()) < jobs && !g_stop) {
+  while ((next < order.size() || !running.empty()) && !stop()) {
+    while (next < order.size() && int(running.size()) < jobs && !stop()) {
       const size_t r = order[next++];
       auto& g = rungs[r];
       g.predicted_wall_s = study::predict_wall_s(rungs, g, &g.predicted_from);
@@ -272,19 +283,32 @@ int study_main(const Parsed& p) {
         continue;
       }
       running[pid] = {r, std::chrono::steady_clock::now()};
+      if (hooks.on_event)
+        hooks.on_event({{"event", "rung_start"}, {"dir", g.dir}, {"values", g.values},
+                        {"predicted_wall_s", std::isfinite(g.predicted_wall_s) ? nlohmann::json(g.predicted_wall_s)
+                                                                               : nlohmann::json(nullptr)},
+                        {"started", finished + running.size()}, {"rungs", rungs.size()}});
       // FURROW_SIGTERM_AFTER_RUNGS (tests of the stop): the signal arrives with a rung running
       if (sigterm_after > 0 && finished_here == sigterm_after) std::raise(SIGTERM);
     }
     // a stop that came while rungs were being started must not wait for them to finish
-    if (running.empty() || g_stop) break;
+    if (running.empty() || stop()) break;
+    // polls its own children only (a Python process may have others), checking for a stop between
     int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, 0);
-    if (pid < 0) {
-      if (errno == EINTR) continue;
-      break;
+    pid_t pid = 0;
+    for (const auto& [child, job] : running) {
+      const pid_t w = ::waitpid(child, &status, WNOHANG);
+      if (w == child || (w < 0 && errno != EINTR)) {
+        if (w < 0) status = 255 << 8;  // cannot be waited for (not expected): a failed rung
+        pid = child;
+        break;
+      }
+    }
+    if (pid == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      continue;
     }
     const auto it = running.find(pid);
-    if (it == running.end()) continue;
     const size_t r = it->second.rung;
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.start).count();
     running.erase(it);
@@ -311,6 +335,10 @@ int study_main(const Parsed& p) {
     }
     failed += g.ok ? 0 : 1;
     write_outputs(false);
+    if (hooks.on_event)
+      hooks.on_event({{"event", "rung_done"}, {"dir", g.dir}, {"values", g.values}, {"ok", g.ok}, {"error", g.error},
+                      {"value", g.ok && std::isfinite(g.value) ? nlohmann::json(g.value) : nlohmann::json(nullptr)},
+                      {"wall_s", g.ok ? g.wall_s : wall}, {"finished", finished}, {"rungs", rungs.size()}});
     if (!quiet) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       char value[96] = "";
@@ -347,8 +375,6 @@ int study_main(const Parsed& p) {
   return failed ? 1 : 0;
 }
 
-}  // namespace
-
 Command command_study() {
   Command c{"study", "what accuracy costs: a scene over a ladder of dx / shape functions / particles per cell",
             "furrow study SCENE.json --ladder KEY=VALUES [--ladder ...] [--quantity Q] [--body NAME] [--jobs N] [--out DIR]",
@@ -382,7 +408,7 @@ Command command_study() {
              {"--jobs", true, false, "rungs at a time (default 1)", "N"},
              {"--out", true, false, "study directory (default out/<scene name>_study); an existing one is resumed",
               "DIR"}},
-            1, 1, study_main};
+            1, 1, [](const Parsed& p) { return study_main(p, cli_driver_hooks()); }};
   for (auto& o : scene_run_options()) c.options.push_back(o);
   return c;
 }

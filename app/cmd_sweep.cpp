@@ -1,9 +1,11 @@
 // furrow sweep: one scene over the cartesian product of --vary values, N runs at a time or over
 // the ranks of an MPI job (app/mpi_sweep.cpp), each into its own run directory, then sweep.csv
-// (+ sweep.json, sweep.png) over all of them. Running it again finishes what is missing.
+// (+ sweep.json, sweep.png) over all of them. Running it again finishes what is missing. In the
+// app core: the Python module's furrow.sweep runs this same driver (app/drivers.hpp).
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,10 +16,10 @@
 #include <thread>
 
 #include "app/commands.hpp"
+#include "app/drivers.hpp"
 #include "app/mpi_sweep.hpp"
 #include "app/progress.hpp"
 #include "app/run_dirs.hpp"
-#include "app/run_movies.hpp"
 #include "app/sweep.hpp"
 #include "app/sweep_plot.hpp"
 #include "engine/field_store.hpp"
@@ -63,12 +65,14 @@ struct Plan {
   std::vector<std::string> names;   // run directory per combination
   std::vector<Scene> scenes;        // per combination; unused where invalid[r] is set
   std::vector<std::string> invalid; // per combination: why its scene cannot run, "" when it can
+  std::exception_ptr first_invalid; // the first of those errors
   fs::path out_dir;
 };
 
-// Throws UsageError. A scene error that leaves nothing to run is printed (when `speak`) and
-// gives no plan.
-std::optional<Plan> plan_sweep(const Parsed& p, bool speak) {
+// Throws UsageError. A scene error that leaves nothing to run is written (when `speak`) or thrown
+// (hooks.throw_scene_errors) and gives no plan.
+std::optional<Plan> plan_sweep(const Parsed& p, bool speak, const DriverHooks& hooks) {
+  std::ostream& err = hooks.err ? *hooks.err : std::cerr;
   Plan plan;
   plan.scene_path = p.positional[0];
   plan.varies = parse_varies(p, "--vary", "nothing to sweep: give at least one --vary KEYS=VALUES");
@@ -79,7 +83,8 @@ std::optional<Plan> plan_sweep(const Parsed& p, bool speak) {
   try {
     plan.base = load_scene_for_cli(p, plan.scene_path);
   } catch (const SceneError& e) {
-    if (speak) std::cerr << "furrow sweep: " << e.what() << "\n";
+    if (hooks.throw_scene_errors) throw;
+    if (speak) err << "furrow sweep: " << e.what() << "\n";
     return std::nullopt;
   }
   for (const auto& c : plan.combos) {
@@ -89,14 +94,16 @@ std::optional<Plan> plan_sweep(const Parsed& p, bool speak) {
       plan.scenes.back() = load_varied_scene(p, plan.scene_path, plan.varies, c, "--vary");
     } catch (const SceneError& e) {
       plan.invalid.back() = e.what();
+      if (!plan.first_invalid) plan.first_invalid = std::current_exception();
     }
   }
   if (std::all_of(plan.invalid.begin(), plan.invalid.end(), [](const std::string& w) { return !w.empty(); })) {
+    if (hooks.throw_scene_errors) std::rethrow_exception(plan.first_invalid);
     std::vector<std::string> said;  // combinations often fail alike: each message once
     for (const auto& w : plan.invalid)
       if (std::find(said.begin(), said.end(), w) == said.end()) said.push_back(w);
     for (const auto& w : said)
-      if (speak) std::cerr << "furrow sweep: " << w << "\n";
+      if (speak) err << "furrow sweep: " << w << "\n";
     return std::nullopt;
   }
   plan.names = sweep::run_dir_names(plan.base.name, plan.varies, plan.combos);
@@ -135,7 +142,7 @@ bool holds_this_sweep(const fs::path& dir, const Plan& plan) {
 }
 
 // Rank 0: new, resumed or (--force) replacing directory; which runs are done; errors printed.
-Decision decide(const Parsed& p, const Plan& plan) {
+Decision decide(const Parsed& p, const Plan& plan, std::ostream& err) {
   Decision d;
   d.work_dir = plan.out_dir;
   d.reused.assign(plan.names.size(), false);
@@ -144,7 +151,7 @@ Decision decide(const Parsed& p, const Plan& plan) {
     fs::remove_all(d.work_dir);
   } else if (fs::exists(plan.out_dir)) {
     if (!holds_this_sweep(plan.out_dir, plan)) {
-      std::cerr << "furrow sweep: " << plan.out_dir.string() << " already exists and is not this sweep (its "
+      err << "furrow sweep: " << plan.out_dir.string() << " already exists and is not this sweep (its "
                 << "sweep.json does not list these runs); pass --out DIR for a new sweep or --force to replace it\n";
       return {1, {}, {}, {}};
     }
@@ -158,10 +165,10 @@ Decision decide(const Parsed& p, const Plan& plan) {
       if (m.state == RunDirState::incomplete) fs::remove_all(dir);  // holds no finished result
     }
     if (!conflicts.empty()) {
-      std::cerr << "furrow sweep: " << plan.out_dir.string()
+      err << "furrow sweep: " << plan.out_dir.string()
                 << " holds runs of another version of this sweep's scene; they would not belong in one table:\n";
-      for (const auto& c : conflicts) std::cerr << "  " << c << "\n";
-      std::cerr << "pass --out DIR for a new sweep or --force to replace it\n";
+      for (const auto& c : conflicts) err << "  " << c << "\n";
+      err << "pass --out DIR for a new sweep or --force to replace it\n";
       return {1, {}, {}, {}};
     }
     remove_stale_partials(plan.out_dir);
@@ -197,11 +204,14 @@ nlohmann::json sweep_json(const Parsed& p, const Plan& plan, const std::vector<s
   return j;
 }
 
-int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
+int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job, const DriverHooks& hooks) {
   const bool quiet = p.has("--quiet");
   const bool root = job.rank() == 0;
+  std::ostream& err = hooks.err ? *hooks.err : std::cerr;
+  if (p.has("--movies") && !hooks.render_movies)
+    throw UsageError("--movies: no renderer here (the Python module): render the runs' movies with `furrow render RUN`");
   Decision d;
-  if (root) d = decide(p, plan);
+  if (root) d = decide(p, plan, err);
   d = decision_from(nlohmann::json::parse(job.broadcast(decision_json(d).dump())));
   if (d.exit_status != 0) return root ? d.exit_status : 0;
 
@@ -218,19 +228,39 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
   }
 
   std::mutex render_mutex;
+  // a stop (hooks.stop_requested) ends the running runs with a checkpoint and starts no more
+  std::atomic<bool> stopping{false};
+  std::vector<char> stopped(plan.names.size(), 0);  // per run, written by its own thread
+  auto stop_now = [&] { return stopping || (hooks.stop_requested && hooks.stop_requested() && (stopping = true)); };
   auto run = [&](size_t r) {
     mpi::Outcome o;
     o.index = r;
     o.rank = job.rank();
     const auto w0 = std::chrono::steady_clock::now();
+    if (stop_now()) {
+      stopped[r] = 1;
+      o.error = "stopped before it started";
+      return o;
+    }
     try {
       RunOptions opt;
       opt.out_dir = (d.work_dir / plan.names[r]).string();
       opt.write_paraview = !p.has("--no-paraview");
+      opt.resume = true;  // a run a stop left with a checkpoint continues from it (bit-identically)
+      if (hooks.stop_requested) opt.stop_requested = stop_now;
+      opt.progress_interval_s = hooks.run_progress_interval_s;
+      if (hooks.on_run_progress) opt.progress = [&, r](const RunProgress& pr) { hooks.on_run_progress(plan.names[r], pr); };
       const RunSummary s = run_scene(scenes[r], opt);
+      if (s.stopped) {
+        stopped[r] = 1;
+        o.error = "stopped at step " + std::to_string(s.run_json.value("steps", int64_t(0))) + " (checkpoint in " +
+                  s.out_dir + ")";
+        o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+        return o;
+      }
       if (p.has("--movies")) {
         std::lock_guard<std::mutex> lock(render_mutex);  // one GL context at a time
-        render_run_movies(s.out_dir, scenes[r], true);
+        hooks.render_movies(s.out_dir, scenes[r]);
       }
       o.ok = true;
     } catch (const std::exception& e) {
@@ -290,10 +320,13 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
     row.ok = o.ok;
     row.error = o.error;
     row.wall_s = o.wall_s;
-    status[o.index] = o.ok ? "ok" : "failed";
+    status[o.index] = o.ok ? "ok" : stopped[o.index] ? "stopped" : "failed";
     ran_on[o.index] = o.rank;
     if (o.ok) collect(o.index);
     ++done;
+    if (hooks.on_event)
+      hooks.on_event({{"event", "run_done"}, {"dir", row.dir}, {"values", row.values}, {"status", status[o.index]},
+                      {"error", row.error}, {"wall_s", row.wall_s}, {"done", done}, {"todo", d.todo.size()}});
     if (quiet) return;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double eta = elapsed / double(done) * double(d.todo.size() - done);
@@ -304,6 +337,16 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
   };
   job.distribute(d.todo, jobs, run, on_done);
   if (!root) return 0;
+  if (stopping) {  // the table waits for the runs the next invocation finishes
+    write_file_atomic((d.work_dir / "sweep.json").string(),
+                      sweep_json(p, plan, rows, status, ran_on, job.size(), jobs, threads_each).dump(2) + "\n");
+    const size_t finished = size_t(std::count(status.begin(), status.end(), "ok")) +
+                            size_t(std::count(status.begin(), status.end(), "reused"));
+    if (!quiet)
+      std::fprintf(stderr, "furrow sweep: stopped; %zu of %zu runs are done in %s. Run the same sweep again to finish "
+                   "the rest.\n", finished, rows.size(), d.work_dir.string().c_str());
+    return 130;
+  }
 
   // ---- table, description, figure ----
   for (size_t r = 0; r < rows.size(); ++r)
@@ -326,13 +369,13 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
   j["figure"] = figure.kind;
   write_file_atomic((d.work_dir / "sweep.json").string(), j.dump(2) + "\n");
   bool plotted = false;
-  try {
-    // the directory holds this sweep (decide() checked): its figure follows the table just written
-    render::write_figure_png(figure.figure, (d.work_dir / "sweep.png").string(), true);
-    plotted = true;
-  } catch (const std::exception& e) {
-    std::cerr << "furrow sweep: warning: no sweep.png: " << e.what() << "\n";
-  }
+  if (hooks.write_figure_png) try {
+      // the directory holds this sweep (decide() checked): its figure follows the table just written
+      hooks.write_figure_png(figure.figure, (d.work_dir / "sweep.png").string());
+      plotted = true;
+    } catch (const std::exception& e) {
+      err << "furrow sweep: warning: no sweep.png: " << e.what() << "\n";
+    }
 
   if (d.work_dir != plan.out_dir) {  // --force: the new sweep is complete, the old one goes
     const fs::path old = plan.out_dir.string() + ".replaced-" + std::to_string(::getpid());
@@ -355,11 +398,19 @@ int run_sweep(const Parsed& p, const Plan& plan, mpi::Job& job) {
   return failed ? 1 : 0;
 }
 
-int sweep_main(const Parsed& p) {
+}  // namespace
+
+DriverHooks& cli_driver_hooks() {
+  static DriverHooks hooks;
+  return hooks;
+}
+
+int sweep_main(const Parsed& p, const DriverHooks& hooks) {
+  std::ostream& err = hooks.err ? *hooks.err : std::cerr;
   const int launched = mpi::launched_rank();
   if (launched >= 0 && !mpi::built_with_mpi()) {
     if (launched == 0)
-      std::cerr << "furrow sweep: started by an MPI launcher, but this furrow was built without MPI (furrow "
+      err << "furrow sweep: started by an MPI launcher, but this furrow was built without MPI (furrow "
                    "--version): run the sweep without mpirun/srun, or rebuild with -DFURROW_MPI=ON\n";
     return 1;
   }
@@ -367,7 +418,7 @@ int sweep_main(const Parsed& p) {
   const bool speak = launched <= 0;
   std::optional<Plan> plan;
   try {
-    plan = plan_sweep(p, speak);
+    plan = plan_sweep(p, speak, hooks);
   } catch (const UsageError&) {
     if (!speak) return 2;
     throw;
@@ -376,16 +427,16 @@ int sweep_main(const Parsed& p) {
 
   mpi::Job job;  // MPI_Init only under an MPI launcher
   try {
-    return run_sweep(p, *plan, job);
+    return run_sweep(p, *plan, job, hooks);
+  } catch (const UsageError&) {
+    throw;
   } catch (const std::exception& e) {
-    std::cerr << "furrow sweep: error" << (job.size() > 1 ? " on rank " + std::to_string(job.rank()) : "") << ": "
+    err << "furrow sweep: error" << (job.size() > 1 ? " on rank " + std::to_string(job.rank()) : "") << ": "
               << e.what() << "\n";
     job.abort(1);  // the other ranks may be waiting on this one
     return 1;
   }
 }
-
-}  // namespace
 
 Command command_sweep() {
   Command c{"sweep", "run a scene over parameter combinations: sweep.csv and a summary plot",
@@ -424,7 +475,7 @@ Command command_sweep() {
              {"--force", false, false, "rerun every run; replace DIR once the new sweep completes"},
              {"--movies", false, false, "render each run's movies (off by default in sweeps)"},
              {"--no-paraview", false, false, "skip the ParaView .vti/.pvd files of the runs"}},
-            1, 1, sweep_main};
+            1, 1, [](const Parsed& p) { return sweep_main(p, cli_driver_hooks()); }};
   for (auto& o : scene_run_options()) c.options.push_back(o);
   return c;
 }

@@ -6,8 +6,11 @@
 #include <vector>
 
 #include "app/cli.hpp"
+#include "app/drivers.hpp"
 #include "app/mpi_sweep.hpp"
+#include "app/run_movies.hpp"
 #include "engine/simulation.hpp"
+#include "render/plot.hpp"
 
 using namespace furrow;
 
@@ -37,6 +40,12 @@ int main(int argc, char** argv) {
               << "\ninstruction set: " << furrow::instruction_set() << "\n";
     return 0;
   }
+  // sweep and study live in the app core (shared with the Python module); the CLI draws for them
+  auto& hooks = cli::cli_driver_hooks();
+  hooks.write_figure_png = [](const render::PlotFigure& f, const std::string& path) {
+    render::write_figure_png(f, path, true);
+  };
+  hooks.render_movies = [](const std::string& dir, const Scene& s) { cli::render_run_movies(dir, s, true); };
   const cli::Command* cmd = nullptr;
   for (const auto& c : cli::commands())
     if (c.name == args[0]) cmd = &c;

@@ -75,8 +75,13 @@ std::string fnv1a_hex(const std::string& bytes) {
 
 std::string scene_hash(const Scene& scene) { return fnv1a_hex(result_defining_json(scene).dump()); }
 
+// Defined (from a hash of the engine library) by the CLI and the Python module, which link the same
+// engine and so continue each other's checkpoints; absent in other programs (weak: null there).
+extern "C" const char* furrow_engine_build_hash() __attribute__((weak));
+
 const std::string& build_id() {
   static const std::string id = [] {
+    if (furrow_engine_build_hash) return std::string(FURROW_VERSION) + "-" + furrow_engine_build_hash();
     // the file holding this code: the executable, or the Python module (a shared object) that
     // links the engine, so a checkpoint names that module's build and not the interpreter's
     std::string file = "/proc/self/exe";

@@ -1,6 +1,6 @@
 // furrow._furrow: the engine and app core seen from Python. Thin on purpose: every result comes from
-// the same functions the CLI calls (scene_io, run_scene, read_forces_csv, read_frame, read_points);
-// furrow/__init__.py arranges them for notebooks.
+// the same functions the CLI calls (scene_io, run_scene, read_forces_csv, read_frame, read_points,
+// and the sweep and study drivers of app/drivers.hpp); furrow/__init__.py arranges them for notebooks.
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -8,11 +8,18 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <sstream>
+#include <thread>
 
 #include "app/calibration.hpp"
+#include "app/commands.hpp"
+#include "app/drivers.hpp"
 #include "app/sweep.hpp"
 #include "engine/field_store.hpp"
 #include "engine/point_store.hpp"
@@ -132,6 +139,79 @@ py::tuple run(const PyScene& s, const std::string& out_dir, bool force, bool par
     summary = run_scene(s.scene, opt);
   }
   return py::make_tuple(summary_dict(summary), error ? *error : py::object(py::none()));
+}
+
+// `furrow sweep` / `furrow study` with the command line `args` (after the command name), run by the
+// CLI's own driver on a thread of its own: a sweep's runs go on worker threads, where Python sees no
+// signals, so the calling thread waits and asks Python about Ctrl-C every 0.1 s. `progress(dict)`
+// gets the driver's events and its runs' progress. Returns (exit status, what the driver wrote as
+// errors, the exception that stopped it or None).
+py::tuple drive(const std::string& command, const std::vector<std::string>& args, py::object progress,
+                double progress_interval_s, const std::string& furrow_exe) {
+  const cli::Command cmd = command == "sweep" ? cli::command_sweep() : cli::command_study();
+  const cli::Parsed parsed = cli::parse(cmd, args);
+  std::ostringstream err;
+  cli::DriverHooks hooks;
+  hooks.err = &err;
+  hooks.throw_scene_errors = true;
+  hooks.furrow_exe = furrow_exe;
+  hooks.run_progress_interval_s = progress_interval_s;
+  std::atomic<bool> stop{false};
+  std::optional<py::object> error;  // touched with the GIL held only
+  // with the GIL held: run `f`, turning a Python exception into a stop
+  auto guarded = [&](auto&& f) {
+    if (error) return;
+    try {
+      f();
+    } catch (py::error_already_set& e) {
+      error = e.value();
+      stop = true;
+    }
+  };
+  hooks.stop_requested = [&] { return stop.load(); };
+  if (!progress.is_none()) {
+    hooks.on_event = [&](const nlohmann::json& e) {
+      py::gil_scoped_acquire gil;
+      guarded([&] { progress(json_to_python(e)); });
+    };
+    hooks.on_run_progress = [&](const std::string& dir, const RunProgress& p) {
+      py::gil_scoped_acquire gil;
+      guarded([&] {
+        py::dict d = progress_dict(p);
+        d["event"] = "run_progress";
+        d["dir"] = dir;
+        progress(d);
+      });
+    };
+  }
+  int status = 0;
+  std::exception_ptr failure;
+  std::mutex m;
+  std::condition_variable finished;
+  bool done = false;
+  std::thread driver([&] {
+    try {
+      status = command == "sweep" ? cli::sweep_main(parsed, hooks) : cli::study_main(parsed, hooks);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(m);
+    done = true;
+    finished.notify_all();
+  });
+  for (bool over = false; !over;) {
+    {
+      py::gil_scoped_release released;
+      std::unique_lock<std::mutex> lock(m);
+      over = finished.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; });
+    }
+    guarded([] {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    });
+  }
+  driver.join();
+  if (failure) std::rethrow_exception(failure);
+  return py::make_tuple(status, err.str(), error ? *error : py::object(py::none()));
 }
 
 // A Simulation stepped by hand (no run directory).
@@ -268,6 +348,8 @@ PYBIND11_MODULE(_furrow, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const cli::UsageError& e) {  // a bad sweep/study argument, worded as the CLI's
+      PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const SceneError& e) {
       py::object exc = py::reinterpret_borrow<py::object>(scene_error)(e.what());
       exc.attr("file") = e.file;
@@ -311,6 +393,8 @@ PYBIND11_MODULE(_furrow, m) {
   m.def("parse_scene", &parse_text);
 
   m.def("run", &run);
+  m.def("drive", &drive);
+  m.attr("cli_path") = FURROW_CLI_PATH;
   m.def("checkpoint_dirs", &checkpoint_dirs);
 
   py::class_<PySimulation>(m, "Simulation")

@@ -1,5 +1,7 @@
 # A run stopped from Python leaves a checkpoint that resumes bit-identically, in Python or with
-# `furrow run --resume-any-build` (the CLI and the module are two builds: two files with their own hash).
+# `furrow run --resume`: the CLI and the module name the same build (a hash of the engine library
+# both link), so the CLI takes the module's checkpoint as its own.
+import json
 import os
 import signal
 
@@ -39,9 +41,16 @@ def test_stopped_in_python_resumed_by_the_cli(small_plate_file, plate_runs, tmp_
     stdout, stderr = p.communicate(timeout=120)
     assert p.returncode == 0, stderr
     assert stdout.split() == ["True", str(STOP_AT_STEP)]
-    r = cli("run", small_plate_file, "--out", out, "--resume-any-build", "--no-movies")
+    r = cli("run", small_plate_file, "--out", out, "--resume", "--no-movies")
     assert f"resumed from the checkpoint at step {STOP_AT_STEP}" in r.stderr
     assert (out / "forces.csv").read_bytes() == (plate_runs["cli"] / "forces.csv").read_bytes()
+    run_json = json.loads((out / "run.json").read_text())
+    assert "resumed_across_builds" not in run_json
+
+
+def test_the_cli_and_the_module_are_one_build(plate_runs):
+    py, cli_run = (json.loads((plate_runs[k] / "run.json").read_text())["build"] for k in ("py", "cli"))
+    assert py == cli_run and py.startswith(furrow.__version__ + "-")
 
 
 def test_ctrl_c_stops_with_a_checkpoint(small_plate_file, tmp_path):

@@ -3,8 +3,11 @@
 Everything is computed by the same C++ engine as the `furrow` CLI (the extension furrow._furrow);
 this file only arranges its results for notebooks. See app/python/README.md.
 """
+import csv
 import json
 import os
+import shutil
+import warnings
 
 import numpy as np
 
@@ -17,7 +20,7 @@ SceneError = _furrow.SceneError  # ValueError; .file, .path (JSON pointer), .val
 class StopRun(Exception):
     """Raise from a progress callback to stop a run: furrow.run then returns its summary with
     stopped=True (the checkpoint in summary["out_dir"] continues with resume=True or
-    `furrow run --resume-any-build`)."""
+    `furrow run --resume`). Stops a sweep or a study the same way."""
 
 
 def templates():
@@ -308,3 +311,189 @@ class Run:
 def open_run(path):
     """A finished run directory: .run_json, .scene, .forces, .frame(i)[field], .particles(i)."""
     return Run(path)
+
+
+# ---- sweeps and studies: the CLI's drivers, given the CLI's command line ----
+
+class Table:
+    """A sweep.csv or study.csv as columns: table[column] is a float array (empty cells NaN) when
+    every cell is a number, else an array of str. Column names carry the units, as in the file."""
+
+    def __init__(self, path):
+        self.path = os.fspath(path)
+        with open(self.path, newline="") as f:
+            rows = list(csv.reader(f))
+        self.columns = rows[0] if rows else []
+        self._columns = {}
+        for k, name in enumerate(self.columns):
+            cells = [r[k] if k < len(r) else "" for r in rows[1:]]
+            try:
+                self._columns[name] = np.array([float(c) if c != "" else np.nan for c in cells], dtype=float)
+            except ValueError:
+                self._columns[name] = np.array(cells, dtype=str)
+        self.rows = len(rows) - 1 if rows else 0
+
+    def __getitem__(self, column):
+        if column not in self._columns:
+            raise KeyError(f"{self.path}: no column '{column}'; it has {', '.join(self.columns)}")
+        return self._columns[column]
+
+    def __contains__(self, column):
+        return column in self._columns
+
+    def __len__(self):
+        return self.rows
+
+    def keys(self):
+        return list(self.columns)
+
+    def dataframe(self):
+        """The table as a pandas DataFrame (needs pandas), columns in the file's order."""
+        import pandas as pd
+
+        return pd.DataFrame({c: self._columns[c] for c in self.columns})
+
+    def __repr__(self):
+        return f"<furrow.Table {self.path!r}: {self.rows} rows, {len(self.columns)} columns>"
+
+
+def _vary_args(option, varies):
+    """{key: [values] or "a:b:step"} or ["KEYS=VALUES", ...] -> the CLI's --vary/--ladder arguments."""
+    if isinstance(varies, str):
+        varies = [varies]
+    if isinstance(varies, dict):
+        specs = []
+        for key, values in varies.items():
+            if not isinstance(values, str):
+                values = ",".join(v if isinstance(v, str) else json.dumps(v) for v in values)
+            specs.append(f"{key}={values}")
+        varies = specs
+    args = []
+    for spec in varies:
+        args += [option, spec]
+    return args
+
+
+def _scene_args(scene, set, threads, yes, quiet):
+    if not isinstance(scene, (str, os.PathLike)):
+        raise TypeError("sweep and study read the scene from its file (they load it again per run, as the CLI): "
+                        "pass a path; a Scene object can be written with scene.save(path)")
+    args = [os.fspath(scene)]
+    for s in _overrides(set):
+        args += ["--set", s]
+    if threads is not None:
+        args += ["--threads", str(int(threads))]
+    if yes:
+        args.append("--yes")
+    if quiet:
+        args.append("--quiet")
+    return args
+
+
+def _drive(command, args, progress, progress_interval_s=0.5, exe=""):
+    status, errors, error = _furrow.drive(command, args, progress, float(progress_interval_s), exe)
+    if error is not None and not isinstance(error, StopRun):
+        if isinstance(error, KeyboardInterrupt):
+            raise KeyboardInterrupt(f"furrow {command} stopped; what finished is kept (run it again to finish the "
+                                    f"rest)") from error
+        raise error
+    if errors.strip():
+        if status != 0:
+            raise RuntimeError(errors.strip())
+        warnings.warn(errors.strip())
+    return status
+
+
+class SweepResult:
+    """A sweep directory: .table (sweep.csv; None when the sweep was stopped before its end),
+    .json (sweep.json), .status (the CLI's exit status: 0, 1 when runs failed, 130 stopped),
+    .stopped, .failed (rows that failed), .run(i) (open_run of row i's directory)."""
+
+    def __init__(self, path, status):
+        self.path = os.fspath(path)
+        self.status = status
+        self.stopped = status == 130
+        with open(os.path.join(self.path, "sweep.json")) as f:
+            self.json = json.load(f)
+        csv_path = os.path.join(self.path, "sweep.csv")
+        self.table = Table(csv_path) if not self.stopped and os.path.isfile(csv_path) else None
+        self.failed = [r for r in self.json.get("runs", []) if r.get("status") == "failed"]
+
+    def dataframe(self):
+        return self.table.dataframe()
+
+    def run(self, i):
+        return open_run(os.path.join(self.path, self.json["runs"][i]["dir"]))
+
+    def __repr__(self):
+        return f"<furrow.SweepResult {self.path!r}: {len(self.json.get('runs', []))} runs, status {self.status}>"
+
+
+def sweep(scene, vary, out, set=None, jobs=1, threads=None, force=False, paraview=True, movies=False, yes=False,
+          progress=None, progress_interval_s=0.5, quiet=True):
+    """`furrow sweep SCENE --vary ... --out OUT`, run by the CLI's own code: every combination of
+    `vary` ({"key.path": [v1, v2] or "a:b:step"} or ["KEYS=VALUES", ...], as --vary) into OUT, the
+    same run directories, sweep.json and sweep.csv (sweep.png only from the CLI, which draws it:
+    `furrow sweep` again with the same arguments reuses every run and adds it). The runs go with
+    the GIL released; `progress(dict)` gets {"event": "run_progress", "dir", "fraction", ...} (every
+    progress_interval_s per run) and {"event": "run_done", "dir", "status", ...}. Ctrl-C or an exception in `progress` stops the
+    runs with a checkpoint and is raised again; furrow.StopRun returns the result with
+    stopped=True; the same call again finishes the rest. A bad scene or --vary key raises
+    SceneError (JSON path), a bad --vary ValueError. Returns a SweepResult."""
+    args = _scene_args(scene, set, threads, yes, quiet) + _vary_args("--vary", vary)
+    args += ["--out", os.fspath(out), "--jobs", str(int(jobs))]
+    if force:
+        args.append("--force")
+    if not paraview:
+        args.append("--no-paraview")
+    if movies:
+        args.append("--movies")
+    status = _drive("sweep", args, progress, progress_interval_s)
+    return SweepResult(out, status)
+
+
+def cli_path():
+    """The furrow CLI a study runs its rungs with: $FURROW_CLI, else the one built beside this
+    module, else `furrow` on PATH."""
+    for candidate in (os.environ.get("FURROW_CLI"), _furrow.cli_path, shutil.which("furrow")):
+        if candidate and os.access(candidate, os.X_OK):
+            return candidate
+    raise FileNotFoundError(f"no furrow CLI to run a study's rungs: not at {_furrow.cli_path}, not on PATH; set "
+                            "FURROW_CLI to its path")
+
+
+class StudyResult:
+    """A study directory: .table (study.csv), .json (study.json), .markdown (study.md),
+    .reference (the converged estimate, None without one), .status (0, 1 failed rungs, 130 stopped)."""
+
+    def __init__(self, path, status):
+        self.path = os.fspath(path)
+        self.status = status
+        self.stopped = status == 130
+        with open(os.path.join(self.path, "study.json")) as f:
+            self.json = json.load(f)
+        self.table = Table(os.path.join(self.path, "study.csv"))
+        with open(os.path.join(self.path, "study.md")) as f:
+            self.markdown = f.read()
+        self.reference = self.json.get("reference")
+
+    def dataframe(self):
+        return self.table.dataframe()
+
+    def __repr__(self):
+        return f"<furrow.StudyResult {self.path!r}: {len(self.table)} rungs, reference {self.reference}>"
+
+
+def study(scene, ladder, out, quantity="drag_mean", body=None, set=None, jobs=1, threads=None, yes=False,
+          progress=None, quiet=True, cli=None):
+    """`furrow study SCENE --ladder ... --out OUT`, run by the CLI's own code: each rung a child
+    `furrow run` (cli_path(), or `cli`), cheapest first; writes study.csv, study.md, study.json
+    (study.png only from the CLI). `ladder` as sweep's `vary`. `progress(dict)` gets
+    {"event": "rung_start" | "rung_done", ...}. Ctrl-C stops it (the rungs running get SIGTERM and
+    keep a checkpoint) and is raised again; the same call finishes the rest. Returns a StudyResult."""
+    args = _scene_args(scene, set, threads, yes, quiet) + _vary_args("--ladder", ladder)
+    args += ["--out", os.fspath(out), "--jobs", str(int(jobs)), "--quantity", quantity]
+    if body:
+        args += ["--body", body]
+    status = _drive("study", args, progress, exe=os.fspath(cli) if cli else cli_path())
+    return StudyResult(out, status)
