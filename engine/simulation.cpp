@@ -507,10 +507,6 @@ void Simulation::particles_to_grid() {
       const double ks = K::mls ? -dt_ * V * Dinv_ : 0.0;
       const double s00 = ks * sxx, s01 = ks * sxy, s11 = ks * syy;
       double q00 = m * C00[p], q01 = m * C01[p], q10 = m * C10[p], q11 = m * C11[p];
-      // Linear hat functions carry no affine momentum (PIC/FLIP): their C is the velocity gradient
-      // sum v_i grad w_i, not an APIC moment (D is singular), and as an affine term it lets a point
-      // alone in its cells keep and grow a spurious C (a free-falling column blew up at impact).
-      if constexpr (!K::mls) q00 = q01 = q10 = q11 = 0.0;
       if constexpr (K::mls && !Flip) {
         q00 += s00;
         q01 += s01;
