@@ -468,6 +468,29 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   auto last_checkpoint = clock::now();
   while (!sim.finished()) {
     sim.step();
+    if (opt.after_step) opt.after_step(sim);
+    // A non-finite state stops the run before anything of it is recorded: the rows and frames
+    // written so far stay in the partial directory. Velocities suffice (G2P moves positions by
+    // them; a bad stress or volume reaches them through the next P2G) and cost ~1% of a step.
+    {
+      const Particles& p = sim.particles();
+      bool finite = true;
+      for (size_t i = 0; i < p.size(); ++i) finite &= std::isfinite(p.vx[i] + p.vy[i]);
+      if (!finite) {
+        std::string field;
+        size_t bad = 0;
+        p.for_each_array([&](const char* name, const auto& a) {
+          for (size_t i = 0; i < a.size() && field.empty(); ++i)
+            if (!std::isfinite(double(a[i]))) field = name, bad = i;
+        });
+        forces.close();
+        std::ostringstream msg;
+        msg << "non-finite state at step " << sim.step_count() << " (t = " << sim.time_s() << " s): " << field
+            << " of point " << bad << " at (" << p.x[bad] << ", " << p.y[bad] << ") m; the run stopped, what it wrote is in "
+            << tmp_dir.string();
+        throw std::runtime_error(msg.str());
+      }
+    }
     const StepStats& st = sim.stats();
     contact_sweeps += st.contact_sweeps;
     contact_sweeps_max = std::max(contact_sweeps_max, st.contact_sweeps);

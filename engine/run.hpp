@@ -13,6 +13,8 @@
 
 namespace furrow {
 
+class Simulation;
+
 struct RunProgress {
   double fraction = 0.0;  // of the end criterion (time or displacement)
   double time_s = 0.0;
@@ -44,6 +46,8 @@ struct RunOptions {
   // resume a checkpoint another build of Furrow wrote (refused otherwise: the run would not be
   // bit-identical to an uninterrupted one); run.json then says so ("resumed_across_builds")
   bool resume_any_build = false;
+  // Test hook: called after every step, before the step is checked and recorded.
+  std::function<void(Simulation&)> after_step;
 };
 
 // Per-body force summary over the scene's averaging window.

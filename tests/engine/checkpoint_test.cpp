@@ -271,3 +271,37 @@ TEST(Checkpoint, VersionThreeBodiesAreReadAndTheRunGoesOnUnchanged) {
   EXPECT_EQ(b.bodies()[0].force_N_per_m, a.bodies()[0].force_N_per_m);
   EXPECT_EQ(b.bodies()[0].position_m, a.bodies()[0].position_m);
 }
+
+// A blow-up made by hand: after step 30 one point's vy becomes NaN. The run stops at that step with
+// a message naming step, field, point and position; the force rows written before it are kept in
+// the partial directory and none of them is non-finite; no run directory appears.
+TEST(NonFinite, RunStopsAtTheFirstBadStepAndKeepsWhatItWrote) {
+  Scene s = checkpoint_scene(ContactMethod::Node);
+  Dirs d("nonfinite");
+  RunOptions o = options(d.root / "run");
+  o.write_paraview = false;
+  const size_t victim = 7;
+  o.after_step = [&](Simulation& sim) {
+    if (sim.step_count() == 30) sim.mutable_particles().vy[victim] = std::nan("");
+  };
+  std::string what;
+  try {
+    run_scene(s, o);
+  } catch (const std::runtime_error& e) {
+    what = e.what();
+  }
+  ASSERT_FALSE(what.empty()) << "the run went on past a NaN";
+  EXPECT_NE(what.find("step 30 "), std::string::npos) << what;
+  EXPECT_NE(what.find("vy of point 7 at ("), std::string::npos) << what;
+  EXPECT_FALSE(fs::exists(d.root / "run"));
+  const auto partial = fs::path(d.root / ("run.partial-" + std::to_string(::getpid())));
+  ASSERT_TRUE(fs::exists(partial / "forces.csv"));
+  std::ifstream in(partial / "forces.csv");
+  std::string line;
+  int rows = 0;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    ++rows;
+    EXPECT_EQ(line.find("nan"), std::string::npos) << line;
+  }
+}
