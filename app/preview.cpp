@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace fs = std::filesystem;
 

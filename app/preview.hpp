@@ -11,7 +11,7 @@
 #include <thread>
 #include <utility>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow::cli {
 

@@ -7,9 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "app/commands.hpp"
-#include "engine/scene_io.hpp"
-#include "engine/field_store.hpp"
+#include "app/scene_summary.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/inspector.hpp"
 #include "render/script.hpp"
 

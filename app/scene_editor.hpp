@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "app/preview.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include "render/scene_view.hpp"
 
 namespace furrow::cli {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "engine/bodies.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/shape_functions.hpp"
 #include "engine/simulation.hpp"
 #include "engine/simulation_detail.hpp"

@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow {
 

@@ -18,9 +18,10 @@
 #include <stdexcept>
 
 #include "engine/analysis.hpp"
-#include "engine/field_store.hpp"
-#include "engine/point_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/io/point_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 namespace fs = std::filesystem;

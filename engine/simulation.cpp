@@ -17,7 +17,7 @@
 #include <type_traits>
 
 #include "engine/bodies.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/shape_functions.hpp"
 #include "engine/simulation_detail.hpp"
 

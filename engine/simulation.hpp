@@ -13,7 +13,7 @@
 
 #include "engine/fields.hpp"
 #include "engine/materials.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include <tbb/task_arena.h>
 
 namespace furrow {

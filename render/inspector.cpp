@@ -9,7 +9,7 @@
 
 #include <imgui.h>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"
 #include "render/imgui_offscreen.hpp"

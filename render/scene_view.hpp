@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/image_io.hpp"
 #include "render/inspector.hpp"  // ViewInput

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <thread>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/colormap.hpp"
 #include "app/scene_editor.hpp"
 #include "render/image_io.hpp"

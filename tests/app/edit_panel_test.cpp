@@ -9,7 +9,7 @@
 #include <string>
 
 #include "app/scene_editor.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace {
 

@@ -12,7 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/field_store.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/fields.hpp"
 
 namespace furrow::vdb_detail {

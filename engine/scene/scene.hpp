@@ -1,5 +1,5 @@
 // Scene: the validated, immutable description of a run (SI units throughout).
-// Built from JSON by engine/scene_io; the solver never changes it.
+// Built from JSON by engine/scene/scene_io; the solver never changes it.
 #pragma once
 #include <Eigen/Core>
 #include <optional>

@@ -1,13 +1,10 @@
-// Rasterization of particles onto cells, frame file naming and atomic writes.
-#include "engine/field_store.hpp"
+// Rasterization of particles onto cells and frame file naming.
+#include "engine/io/field_store.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -219,34 +216,6 @@ std::vector<std::string> list_frames(const std::string& run_dir) {
   std::vector<std::string> paths;
   for (auto& f : found) paths.push_back(std::move(f.second));
   return paths;
-}
-
-void write_atomically(const std::string& path,
-                      const std::function<void(const std::string& tmp_path)>& write) {
-  static std::atomic<unsigned> counter{0};
-  const fs::path target(path);
-  std::error_code ec;
-  if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  // a dot-prefixed temporary name in the same folder: same file system, and ignored by listings
-  const fs::path tmp = target.parent_path() / ("." + target.filename().string() + ".tmp" +
-                                               std::to_string(::getpid()) + "_" +
-                                               std::to_string(counter++));
-  try {
-    write(tmp.string());
-    fs::rename(tmp, target);
-  } catch (const std::exception& e) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot write " + path + ": " + e.what());
-  }
-}
-
-void write_file_atomic(const std::string& path, const std::string& bytes) {
-  write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    out.close();
-    if (!out) throw std::runtime_error("write to " + tmp + " failed");
-  });
 }
 
 }  // namespace furrow

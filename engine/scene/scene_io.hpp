@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow {
 
@@ -113,7 +113,7 @@ double time_to_displacement_s(const Motion& motion, double distance_m, double t_
 // Axis-aligned bounds of a shape in its body frame (union parts included), {min, max}.
 std::pair<Vec2, Vec2> shape_bounds_m(const Shape& shape);
 
-// ---- templates (scenes/*.json embedded at build time; engine/scene_templates.cpp) ----
+// ---- templates (scenes/*.json embedded at build time; engine/scene/scene_templates.cpp) ----
 struct SceneTemplate {
   std::string name;         // file stem, e.g. "plate_intrusion"
   std::string description;  // the scene's "description"

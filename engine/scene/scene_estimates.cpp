@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow {
 

@@ -1,7 +1,7 @@
 // Scene templates: scenes/*.json, embedded into the binary by cmake/embed_scenes.cmake.
 #include <algorithm>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow {
 namespace embedded {

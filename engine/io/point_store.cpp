@@ -1,5 +1,5 @@
 // OpenVDB point files: write_points_vdb / read_points (layout documented in point_store.hpp).
-#include "engine/point_store.hpp"
+#include "engine/io/point_store.hpp"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointAttribute.h>
@@ -17,8 +17,8 @@
 #include <memory>
 #include <stdexcept>
 
-#include "engine/field_store.hpp"
-#include "engine/vdb_meta.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/io/vdb_meta.hpp"
 
 namespace furrow {
 

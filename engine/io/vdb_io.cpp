@@ -1,5 +1,5 @@
 // OpenVDB frame files: write_frame_vdb / read_frame (layout documented in field_store.hpp).
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 
 #include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
@@ -8,7 +8,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "engine/vdb_meta.hpp"
+#include "engine/io/vdb_meta.hpp"
 
 namespace furrow {
 

@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "engine/scene_detail.hpp"
+#include "engine/scene/scene_detail.hpp"
 
 namespace furrow {
 

@@ -2,7 +2,7 @@
 // Each object declares its keys once (the k*Keys lists of scene_schema.cpp); the reader rejects any
 // other key with its JSON pointer and the nearest valid key, and checks that every declared key
 // was looked at. Checks across sections (geometry, cost) follow the reading.
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -14,7 +14,7 @@
 
 #include "engine/bodies.hpp"
 #include "engine/fields.hpp"
-#include "engine/scene_detail.hpp"
+#include "engine/scene/scene_detail.hpp"
 
 namespace furrow {
 

@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/scene_detail.hpp"
+#include "engine/scene/scene_detail.hpp"
 
 namespace furrow {
 

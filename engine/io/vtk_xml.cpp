@@ -1,7 +1,8 @@
 // ParaView export written by hand (engine/ does not link VTK): VTK XML ImageData (.vti) per frame
 // and a .pvd collection. Arrays are inline base64 "binary": one base64 run of a UInt32 byte count
 // followed by the little-endian values (VTK's layout for uncompressed inline data).
-#include "engine/field_store.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
 
 #include <algorithm>
 #include <charconv>

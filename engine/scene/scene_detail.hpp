@@ -1,4 +1,4 @@
-// Internals shared by engine/scene_*.cpp (not part of the engine's API): the schema's key lists,
+// Internals shared by engine/scene/scene_*.cpp (not part of the engine's API): the schema's key lists,
 // the error helper and the text helpers for messages.
 #pragma once
 #include <nlohmann/json.hpp>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow::scene_detail {
 

@@ -93,11 +93,4 @@ struct PvdEntry {
 };
 void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries);
 
-// Atomic output: `write` fills a temporary file beside `path` (same directory, so the rename
-// is atomic), which then replaces `path`; on any failure the temporary file is removed and
-// std::runtime_error naming `path` is thrown. Readers never see a half-written file.
-void write_atomically(const std::string& path,
-                      const std::function<void(const std::string& tmp_path)>& write);
-void write_file_atomic(const std::string& path, const std::string& bytes);
-
 }  // namespace furrow

@@ -1,4 +1,4 @@
-// The scene schema's key lists, message helpers and path helpers (engine/scene_detail.hpp), and
+// The scene schema's key lists, message helpers and path helpers (engine/scene/scene_detail.hpp), and
 // schema_keys(), which `--set` uses to tell a missing-but-valid key from a typo.
 #include <algorithm>
 #include <cctype>
@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "engine/scene_detail.hpp"
+#include "engine/scene/scene_detail.hpp"
 
 namespace furrow {
 namespace scene_detail {
