@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "app/scene_editor.hpp"
+#include "app/interactive/scene_editor.hpp"
 #include "engine/scene/scene_io.hpp"
 
 namespace {

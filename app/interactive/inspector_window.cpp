@@ -1,4 +1,4 @@
-#include "render/inspector_window.hpp"
+#include "app/interactive/inspector_window.hpp"
 
 #include <cstdlib>
 #include <stdexcept>

@@ -12,9 +12,9 @@
 #include <variant>
 #include <vector>
 
-#include "app/preview.hpp"
+#include "app/interactive/preview.hpp"
 #include "engine/scene/scene.hpp"
-#include "render/scene_view.hpp"
+#include "app/interactive/scene_view.hpp"
 
 namespace furrow::cli {
 
@@ -91,7 +91,7 @@ render::ScenePanel editor_panel(const EditorState& s);
 
 namespace furrow::cli {
 
-// ---- window (app/edit_window.cpp) ---------------------------------------------------------------
+// ---- window (app/interactive/edit_window.cpp) ---------------------------------------------------
 struct EditWindowOptions {
   std::vector<EditStep> script;  // replayed in the window first
   std::string script_path;

@@ -1,4 +1,4 @@
-#include "app/preview.hpp"
+#include "app/interactive/preview.hpp"
 
 #include <algorithm>
 #include <filesystem>

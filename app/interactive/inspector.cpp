@@ -1,4 +1,4 @@
-#include "render/inspector.hpp"
+#include "app/interactive/inspector.hpp"
 
 #include <algorithm>
 #include <cfloat>

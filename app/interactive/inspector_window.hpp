@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "render/inspector.hpp"
+#include "app/interactive/inspector.hpp"
 
 namespace furrow::render {
 

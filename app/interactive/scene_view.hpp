@@ -15,7 +15,7 @@
 #include "engine/scene/scene.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/image_io.hpp"
-#include "render/inspector.hpp"  // ViewInput
+#include "app/interactive/inspector.hpp"  // ViewInput
 
 namespace furrow::render {
 

@@ -1,4 +1,4 @@
-#include "render/scene_view.hpp"
+#include "app/interactive/scene_view.hpp"
 
 #include <imgui.h>
 

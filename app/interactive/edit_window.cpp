@@ -1,7 +1,7 @@
 // `furrow edit` in a window: the off-screen SceneView shown through render/x_window.
 #include <stdexcept>
 
-#include "app/scene_editor.hpp"
+#include "app/interactive/scene_editor.hpp"
 #include "engine/bodies.hpp"
 #include "render/script.hpp"
 #include "render/x_window.hpp"  // last: X11 macros

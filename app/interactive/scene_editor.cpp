@@ -1,4 +1,4 @@
-#include "app/scene_editor.hpp"
+#include "app/interactive/scene_editor.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -11,7 +11,7 @@
 #include "engine/io/atomic_file.hpp"
 #include "engine/io/field_store.hpp"
 #include "engine/scene/scene_io.hpp"
-#include "render/inspector.hpp"
+#include "app/interactive/inspector.hpp"
 #include "render/script.hpp"
 
 namespace fs = std::filesystem;
