@@ -50,6 +50,10 @@ struct Ctx {
 [[noreturn]] void fail(const Ctx& c, const std::string& path, const char* value, const std::string& expected);
 [[noreturn]] void fail(const Ctx& c, const std::string& path, const json& value, const std::string& expected);
 
+// ---- checks across sections (scene_check.cpp) ----
+std::string idx_path(const char* array, size_t i, const std::string& key = "");  // "/array/i/key"
+void check_scene(const Ctx& c, const Scene& s);  // geometry and cost, after every section is read
+
 // ---- paths ----
 // "a.b.0" or a JSON pointer "/a/b/0" into its segments.
 std::vector<std::string> split_path(const std::string& key_path);
