@@ -11,8 +11,9 @@
 #include <thread>
 
 #include "app/progress.hpp"
-#include "engine/field_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace fs = std::filesystem;
 

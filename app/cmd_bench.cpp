@@ -13,7 +13,7 @@
 
 #include "app/calibration.hpp"
 #include "app/commands.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 namespace furrow::cli {

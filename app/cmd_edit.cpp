@@ -1,11 +1,11 @@
-// `furrow edit`: argument handling only; the editor's state and actions live in app/scene_editor,
-// the drawing in render/scene_view.
+// `furrow edit`: argument handling only; the editor's state and actions live in
+// app/interactive/scene_editor, the drawing in app/interactive/scene_view.
 #include <filesystem>
 #include <iostream>
 
 #include "app/commands.hpp"
-#include "app/scene_editor.hpp"
-#include "render/inspector_window.hpp"
+#include "app/interactive/scene_editor.hpp"
+#include "app/interactive/inspector_window.hpp"
 #include "render/script.hpp"
 
 namespace fs = std::filesystem;

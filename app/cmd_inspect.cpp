@@ -1,12 +1,12 @@
 // `furrow inspect`: argument handling only; the inspector's state, actions and drawing live in
-// render/inspector.
+// app/interactive/inspector.
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
 #include "app/commands.hpp"
-#include "render/inspector.hpp"
-#include "render/inspector_window.hpp"
+#include "app/interactive/inspector.hpp"
+#include "app/interactive/inspector_window.hpp"
 #include "render/script.hpp"
 
 namespace fs = std::filesystem;

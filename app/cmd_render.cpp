@@ -7,8 +7,8 @@
 #include <optional>
 
 #include "app/commands.hpp"
-#include "engine/field_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/colormap.hpp"
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"

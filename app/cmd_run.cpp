@@ -15,7 +15,7 @@
 #include "app/progress.hpp"
 #include "app/run_movies.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace fs = std::filesystem;
 

@@ -28,8 +28,9 @@
 #include "app/run_dirs.hpp"
 #include "app/study.hpp"
 #include "app/sweep.hpp"
-#include "engine/field_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/plot.hpp"
 
 extern char** environ;

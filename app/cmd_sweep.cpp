@@ -22,9 +22,10 @@
 #include "app/run_dirs.hpp"
 #include "app/sweep.hpp"
 #include "app/sweep_plot.hpp"
-#include "engine/field_store.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/plot.hpp"
 
 namespace fs = std::filesystem;

@@ -2,7 +2,7 @@
 #pragma once
 #include "app/cli.hpp"
 #include "app/sweep.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow::cli {
 Command command_run();        // app/cmd_run.cpp
@@ -46,12 +46,4 @@ struct ViewOptions {
   int width = 1280, height = 720;
 };
 int view_options(const Parsed& p, const std::string& command, ViewOptions* o);
-// What a run of the scene will cost and produce, for people: `furrow validate`'s summary, first
-// line 'scene "NAME" (SOURCE) is valid' (app/cmd_scene.cpp).
-std::string scene_summary(const Scene& s, const std::string& source);
-// Writes `text` to `path` through a temporary file in the same directory; an existing file is
-// replaced only with `replace` (and then atomically), otherwise it is never touched and the error
-// reads "PATH: exists; REPLACE_HINT" (app/cmd_scene.cpp).
-void write_text_atomically(const std::string& path, const std::string& text, bool replace,
-                           const std::string& replace_hint);
 }  // namespace furrow::cli

@@ -10,7 +10,7 @@
 
 #include "app/cli.hpp"
 #include "engine/run.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include "render/plot.hpp"
 
 namespace furrow::cli {

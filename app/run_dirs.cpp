@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace fs = std::filesystem;
 

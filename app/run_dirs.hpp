@@ -6,7 +6,7 @@
 #include <string>
 
 #include "app/sweep.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow::cli {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "app/commands.hpp"
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"
 

@@ -3,7 +3,7 @@
 #pragma once
 #include <string>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow::cli {
 void render_run_movies(const std::string& run_dir, const Scene& scene, bool quiet);

@@ -4,7 +4,7 @@
 #include <cstdlib>
 
 #include "app/commands.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow::cli {
 

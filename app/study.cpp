@@ -8,7 +8,7 @@
 
 #include "app/progress.hpp"
 #include "engine/analysis.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow::study {
 

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "engine/analysis.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow::sweep {
 

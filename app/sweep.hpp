@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "engine/run.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow::sweep {
 

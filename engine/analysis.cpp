@@ -6,7 +6,7 @@
 #include <map>
 #include <stdexcept>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow {
 

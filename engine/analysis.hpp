@@ -60,7 +60,7 @@
 #include <vector>
 
 #include "engine/fields.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow {
 

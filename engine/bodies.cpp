@@ -1,5 +1,5 @@
 #include "engine/bodies.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 #include <algorithm>
 #include <cmath>

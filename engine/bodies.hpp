@@ -2,7 +2,7 @@
 #pragma once
 #include <vector>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow {
 
@@ -22,6 +22,6 @@ struct ShapeMass {
 };
 ShapeMass shape_mass_properties(const Shape& s);
 // (bounds and prescribed motion: shape_bounds_m, motion_velocity_m_s, motion_displacement_m in
-// engine/scene_io.hpp, shared with scene validation)
+// engine/scene/scene_io.hpp, shared with scene validation)
 
 }  // namespace furrow

@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow {
 
@@ -89,7 +89,7 @@ inline double fma1(double a, double b, double c) {
 // x = q - 1 (exact for q in [0.5, 2]); |y| <= 0.053, so the odd series to y^13 is exact to 1e-19
 // and the result to about an ulp (tested). Cheaper than the library log (the update's instructions
 // -35% on plate_intrusion, engine/README.md), and the same operations in every lane of the four-wide update
-// (simulation.cpp), which must give the same bits.
+// (constitutive.cpp), which must give the same bits.
 // T is double, or a GCC vector of doubles (one lane per point) with its own `fma`.
 constexpr double kLogSeriesReach = 0.1;
 template <class T, class Fma> inline T log_series(const T& x, Fma fma) {

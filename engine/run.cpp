@@ -14,13 +14,15 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "engine/analysis.hpp"
-#include "engine/field_store.hpp"
-#include "engine/point_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/atomic_file.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/io/point_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 namespace fs = std::filesystem;
@@ -275,59 +277,56 @@ fs::path find_checkpoint(const fs::path& final_dir, const Scene& scene, bool any
   return best;
 }
 
-}  // namespace
-
-RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
+// run_scene's stages, in order: prepare_run_dir (as the run is built), set_up, step_loop, finish.
+// Its locals are members under the same names, so each stage reads as the one function did.
+struct SceneRun {
   using clock = std::chrono::steady_clock;
-  if (opt.out_dir.empty()) throw std::invalid_argument("run_scene: no output directory given");
-  const fs::path final_dir = fs::absolute(opt.out_dir).lexically_normal();
-  if (fs::exists(final_dir) && !opt.force)
-    throw std::runtime_error(final_dir.string() + " already exists: choose another --out or pass --force to replace it");
-  const fs::path tmp_dir = final_dir.string() + ".partial-" + std::to_string(getpid());
-  const fs::path checkpoint_dir = tmp_dir / "checkpoint";
-  nlohmann::json resumed;  // the checkpoint's run state; null for a new run
-  if (opt.resume) {
-    const fs::path from = find_checkpoint(final_dir, scene, opt.resume_any_build);
-    if (!from.empty()) {
-      if (from != tmp_dir) {
-        fs::remove_all(tmp_dir);
-        fs::rename(from, tmp_dir);
-      }
-      std::ifstream in(checkpoint_dir / "run.json");
-      resumed = nlohmann::json::parse(in);
-    }
-  }
-  if (resumed.is_null()) {
-    fs::remove_all(tmp_dir);
-    fs::create_directories(tmp_dir / "frames");
-    write_file_atomic((tmp_dir / "scene.json").string(), format_scene(scene));
-  }
+  const Scene& scene;
+  const RunOptions& opt;
+  fs::path final_dir, tmp_dir, checkpoint_dir;  // set by prepare_run_dir
+  nlohmann::json resumed = prepare_run_dir();  // the checkpoint's run state; null for a new run
+  const clock::time_point wall0 = clock::now();
+  Simulation sim{scene};
+  // the checkpoint's state, before the force log trims forces.csv to the checkpoint's rows
+  const bool state_loaded = load_state();
+  ForceLog forces{(tmp_dir / "forces.csv").string(), scene, resumed.is_null() ? resumed : resumed.at("forces")};
+  ForceStats stats{scene};
+  RunAnalysis analysis{scene};  // run.json "analysis": drag statistics, wedge per frame
+  CollapseAnalysis collapse{scene};  // run.json "collapse": runout and height of a released column
 
-  const auto wall0 = clock::now();
-  Simulation sim(scene);
-  if (!resumed.is_null()) {
-    const std::string path = (checkpoint_dir / "simulation.bin").string();
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path + ": cannot open");
-    sim.load_state(in, path);
-  }
-  ForceLog forces((tmp_dir / "forces.csv").string(), scene, resumed.is_null() ? resumed : resumed.at("forces"));
-  ForceStats stats(scene);
-  RunAnalysis analysis(scene);  // run.json "analysis": drag statistics, wedge per frame
-  CollapseAnalysis collapse(scene);  // run.json "collapse": runout and height of a released column
-
-  const auto& out = scene.outputs;
+  const Outputs& out = scene.outputs;
   std::vector<std::string> fields;
-  for (const auto& f : out.fields) fields.push_back(f);
-  const bool frames_on = out.frame_interval_s > 0.0 && !fields.empty();
+  bool frames_on = false;
   RasterSpec raster;
-  raster.nx = sim.grid().nx;
-  raster.ny = sim.grid().ny;
-  raster.dx_m = scene.domain.dx_m;
   std::vector<PvdEntry> pvd;
   int64_t frame_index = 0;
   double next_frame_s = 0.0;
-  auto write_frame = [&] {
+
+  // progress: the end is whichever criterion comes first
+  const double end_t = scene.solver.end_time_s, end_d = scene.solver.end_displacement_m;
+  double dt_min = std::numeric_limits<double>::max(), dt_max = 0.0;
+  double wall_before_s = 0.0, solver_before_s = 0.0;  // earlier segments of a resumed run
+  double checkpoint_s = 0.0;  // writing checkpoints, all segments: not solver time
+  int segments = 1;
+  clock::time_point loop0;  // the solver loop's start in this segment
+  int64_t steps0 = 0;       // and the step it started from
+  double fraction0 = 0.0;   // and how far the run was then
+  clock::time_point last_report = clock::now();
+  int64_t contact_sweeps = 0, contact_unconverged = 0, contact_points_max = 0;
+  int contact_sweeps_max = 0;
+  double contact_residual_max = 0.0;
+  RunSummary summary;
+  nlohmann::json builds = nlohmann::json::array();  // every build that ran a segment, in order
+  double segment_checkpoint_s = 0.0;
+
+  SceneRun(const Scene& s, const RunOptions& o) : scene(s), opt(o) {}
+  nlohmann::json prepare_run_dir();
+  bool load_state();
+  void set_up();
+  std::optional<RunSummary> step_loop();  // a summary when stopped at a checkpoint
+  RunSummary finish();
+
+  void write_frame() {
     const ParticleView view = sim.particle_view();
     FieldFrame f = rasterize(view, raster, fields);
     f.scene_name = scene.name;
@@ -356,24 +355,13 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     }
     ++frame_index;
     next_frame_s += out.frame_interval_s;
-  };
-
-  // progress: the end is whichever criterion comes first
-  const double end_t = scene.solver.end_time_s, end_d = scene.solver.end_displacement_m;
-  auto fraction = [&] {
+  }
+  double fraction() const {
     double f = end_t > 0.0 ? sim.time_s() / end_t : 0.0;
     if (end_d > 0.0) f = std::max(f, sim.lead_body_travel_m() / end_d);
     return std::min(f, 1.0);
-  };
-  double dt_min = std::numeric_limits<double>::max(), dt_max = 0.0;
-  double wall_before_s = 0.0, solver_before_s = 0.0;  // earlier segments of a resumed run
-  double checkpoint_s = 0.0;  // writing checkpoints, all segments: not solver time
-  int segments = 1;
-  clock::time_point loop0;  // the solver loop's start in this segment
-  int64_t steps0 = 0;       // and the step it started from
-  double fraction0 = 0.0;   // and how far the run was then
-  auto last_report = clock::now();
-  auto report = [&](bool force_report) {
+  }
+  void report(bool force_report) {
     if (!opt.progress) return;
     const auto now = clock::now();
     if (!force_report && std::chrono::duration<double>(now - last_report).count() < opt.progress_interval_s) return;
@@ -393,43 +381,10 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     p.dt_s = sim.last_dt_s();
     p.particle_steps_per_s = loop_s > 0.0 ? double(p.particles) * double(p.steps - steps0) / loop_s : 0.0;
     opt.progress(p);
-  };
-
-  int64_t contact_sweeps = 0, contact_unconverged = 0, contact_points_max = 0;
-  int contact_sweeps_max = 0;
-  double contact_residual_max = 0.0;
-  RunSummary summary;
-  nlohmann::json builds = nlohmann::json::array();  // every build that ran a segment, in order
-  if (!resumed.is_null()) builds = resumed.value("builds", nlohmann::json::array({resumed.value("build", build_id())}));
-  if (builds.empty() || builds.back() != build_id()) builds.push_back(build_id());
-  if (!resumed.is_null()) {
-    summary.resumed_from_step = sim.step_count();
-    const auto& r = resumed;
-    frame_index = r.at("frame_index").get<int64_t>();
-    next_frame_s = r.at("next_frame_s").get<double>();
-    for (const auto& e : r.at("pvd")) pvd.push_back({e.at(0).get<double>(), e.at(1).get<std::string>()});
-    dt_min = r.at("dt_min_s").get<double>(), dt_max = r.at("dt_max_s").get<double>();
-    const auto& c = r.at("contact");
-    contact_sweeps = c.at(0), contact_unconverged = c.at(1), contact_points_max = c.at(2);
-    contact_sweeps_max = c.at(3), contact_residual_max = c.at(4);
-    wall_before_s = r.at("wall_seconds").get<double>();
-    solver_before_s = r.at("solver_seconds").get<double>();
-    checkpoint_s = r.value("checkpoint_seconds", 0.0);
-    segments = r.at("segments").get<int>() + 1;
-    stats.restore(r.at("stats"));
-    analysis.restore(r.at("analysis"));
-    collapse.restore(r.at("collapse"));
-  } else {
-    if (frames_on) write_frame();
-    if (collapse.active()) collapse.add_step(0.0, sim.particle_view());
   }
-  loop0 = clock::now();
-  steps0 = sim.step_count();
-  fraction0 = fraction();
   // The run's state after a step, written beside the old checkpoint and swapped in by two renames
   // (find_checkpoint takes checkpoint.old if a crash falls between them).
-  double segment_checkpoint_s = 0.0;
-  auto save_checkpoint = [&] {
+  void save_checkpoint() {
     const auto t0 = clock::now();
     const fs::path fresh = tmp_dir / "checkpoint.new", old = tmp_dir / "checkpoint.old";
     fs::remove_all(fresh);
@@ -464,7 +419,83 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
     const double took = std::chrono::duration<double>(clock::now() - t0).count();
     segment_checkpoint_s += took;
     checkpoint_s += took;
-  };
+  }
+};
+
+// The run directory: a fresh DIR.partial-PID, or the checkpoint's moved there.
+nlohmann::json SceneRun::prepare_run_dir() {
+  if (opt.out_dir.empty()) throw std::invalid_argument("run_scene: no output directory given");
+  final_dir = fs::absolute(opt.out_dir).lexically_normal();
+  if (fs::exists(final_dir) && !opt.force)
+    throw std::runtime_error(final_dir.string() + " already exists: choose another --out or pass --force to replace it");
+  tmp_dir = final_dir.string() + ".partial-" + std::to_string(getpid());
+  checkpoint_dir = tmp_dir / "checkpoint";
+  nlohmann::json resumed;  // the checkpoint's run state; null for a new run
+  if (opt.resume) {
+    const fs::path from = find_checkpoint(final_dir, scene, opt.resume_any_build);
+    if (!from.empty()) {
+      if (from != tmp_dir) {
+        fs::remove_all(tmp_dir);
+        fs::rename(from, tmp_dir);
+      }
+      std::ifstream in(checkpoint_dir / "run.json");
+      resumed = nlohmann::json::parse(in);
+    }
+  }
+  if (resumed.is_null()) {
+    fs::remove_all(tmp_dir);
+    fs::create_directories(tmp_dir / "frames");
+    write_file_atomic((tmp_dir / "scene.json").string(), format_scene(scene));
+  }
+  return resumed;
+}
+
+bool SceneRun::load_state() {
+  if (!resumed.is_null()) {
+    const std::string path = (checkpoint_dir / "simulation.bin").string();
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path + ": cannot open");
+    sim.load_state(in, path);
+  }
+  return !resumed.is_null();
+}
+
+// What a frame stores, and the run's counters from the checkpoint or the first frame.
+void SceneRun::set_up() {
+  for (const auto& f : out.fields) fields.push_back(f);
+  frames_on = out.frame_interval_s > 0.0 && !fields.empty();
+  raster.nx = sim.grid().nx;
+  raster.ny = sim.grid().ny;
+  raster.dx_m = scene.domain.dx_m;
+  if (!resumed.is_null()) builds = resumed.value("builds", nlohmann::json::array({resumed.value("build", build_id())}));
+  if (builds.empty() || builds.back() != build_id()) builds.push_back(build_id());
+  if (!resumed.is_null()) {
+    summary.resumed_from_step = sim.step_count();
+    const auto& r = resumed;
+    frame_index = r.at("frame_index").get<int64_t>();
+    next_frame_s = r.at("next_frame_s").get<double>();
+    for (const auto& e : r.at("pvd")) pvd.push_back({e.at(0).get<double>(), e.at(1).get<std::string>()});
+    dt_min = r.at("dt_min_s").get<double>(), dt_max = r.at("dt_max_s").get<double>();
+    const auto& c = r.at("contact");
+    contact_sweeps = c.at(0), contact_unconverged = c.at(1), contact_points_max = c.at(2);
+    contact_sweeps_max = c.at(3), contact_residual_max = c.at(4);
+    wall_before_s = r.at("wall_seconds").get<double>();
+    solver_before_s = r.at("solver_seconds").get<double>();
+    checkpoint_s = r.value("checkpoint_seconds", 0.0);
+    segments = r.at("segments").get<int>() + 1;
+    stats.restore(r.at("stats"));
+    analysis.restore(r.at("analysis"));
+    collapse.restore(r.at("collapse"));
+  } else {
+    if (frames_on) write_frame();
+    if (collapse.active()) collapse.add_step(0.0, sim.particle_view());
+  }
+}
+
+std::optional<RunSummary> SceneRun::step_loop() {
+  loop0 = clock::now();
+  steps0 = sim.step_count();
+  fraction0 = fraction();
   auto last_checkpoint = clock::now();
   while (!sim.finished()) {
     sim.step();
@@ -522,6 +553,11 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
       return summary;
     }
   }
+  return std::nullopt;
+}
+
+// run.json, and the run directory moved into place.
+RunSummary SceneRun::finish() {
   const double loop_s =
       solver_before_s + std::chrono::duration<double>(clock::now() - loop0).count() - segment_checkpoint_s;
   if (collapse.active()) collapse.add_step(sim.time_s(), sim.particle_view(), true);
@@ -595,6 +631,15 @@ RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
   }
   summary.out_dir = final_dir.string();
   return summary;
+}
+
+}  // namespace
+
+RunSummary run_scene(const Scene& scene, const RunOptions& opt) {
+  SceneRun run(scene, opt);
+  run.set_up();
+  if (std::optional<RunSummary> stopped = run.step_loop()) return *stopped;
+  return run.finish();
 }
 
 }  // namespace furrow

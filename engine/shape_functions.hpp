@@ -4,7 +4,7 @@
 #pragma once
 #include <cmath>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow {
 

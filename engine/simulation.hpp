@@ -13,7 +13,7 @@
 
 #include "engine/fields.hpp"
 #include "engine/materials.hpp"
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include <tbb/task_arena.h>
 
 namespace furrow {
@@ -261,7 +261,7 @@ class Simulation {
   bool dilatancy_ = false;
   bool flip_ = false;
   bool track_plastic_ = false;
-  // P2G's strips (simulation.cpp, StripWindow): the reorder sorts the points by strip, strip s
+  // P2G's strips (simulation_detail.hpp, StripWindow): the reorder sorts the points by strip, strip s
   // holding points [strip_start_[s], strip_start_[s + 1]) until the next reorder (each point's
   // home strip, home_strip_), and P2G scatters each home strip in two colours without sorting
   // again. G2P reports a point that strayed so far that two strips of a colour could share a node

@@ -6,8 +6,8 @@
 #include <functional>
 #include <stdexcept>
 
-#include "engine/field_store.hpp"
-#include "engine/point_store.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/io/point_store.hpp"
 #include "render/movie_writer.hpp"
 #include "render/point_splat.hpp"
 

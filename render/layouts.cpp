@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace furrow::render {
 

@@ -3,7 +3,7 @@
 #pragma once
 #include <string>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include "render/frame_renderer.hpp"
 
 namespace furrow::render {

@@ -1,5 +1,5 @@
 // Material points drawn as discs coloured by their own value, as the paper's figures draw them:
-// each point of a points file (engine/point_store.hpp) becomes a disc of its own area (radius
+// each point of a points file (engine/io/point_store.hpp) becomes a disc of its own area (radius
 // sqrt(V / pi)) on a grid `sub` times finer than the frame's cells, which the renderer then draws
 // flat. Later points cover earlier ones where discs overlap (the solver's order).
 #pragma once
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "engine/fields.hpp"
-#include "engine/point_store.hpp"
+#include "engine/io/point_store.hpp"
 
 namespace furrow::render {
 

@@ -21,10 +21,10 @@
 #include "app/commands.hpp"
 #include "app/drivers.hpp"
 #include "app/sweep.hpp"
-#include "engine/field_store.hpp"
-#include "engine/point_store.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/io/point_store.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 namespace py = pybind11;

@@ -11,11 +11,11 @@
 #include <sstream>
 #include <thread>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/colormap.hpp"
-#include "app/scene_editor.hpp"
+#include "app/interactive/scene_editor.hpp"
 #include "render/image_io.hpp"
-#include "render/scene_view.hpp"
+#include "app/interactive/scene_view.hpp"
 #include "tests/app/cli_fixture.hpp"
 #include "tests/app/xvfb.hpp"
 

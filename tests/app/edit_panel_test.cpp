@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <string>
 
-#include "app/scene_editor.hpp"
-#include "engine/scene_io.hpp"
+#include "app/interactive/scene_editor.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace {
 

@@ -16,7 +16,7 @@
 #include <sstream>
 #include <thread>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "render/colormap.hpp"
 #include "render/image_io.hpp"
 #include "tests/app/cli_fixture.hpp"

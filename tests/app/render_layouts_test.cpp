@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/point_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/point_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/colormap.hpp"
 #include "render/image_io.hpp"
 #include "tests/app/cli_fixture.hpp"

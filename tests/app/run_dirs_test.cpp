@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "tests/app/sweep_fixture.hpp"
 
 namespace fs = std::filesystem;

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "tests/render/synthetic_frames.hpp"
 
 namespace furrow::cli_test {

@@ -4,7 +4,7 @@
 // Run: build/bench/furrow_engine_bench [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 using namespace furrow;

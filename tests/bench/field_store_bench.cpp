@@ -2,7 +2,7 @@
 // Frame: 400 x 250 cells, all holding material, with velocity, pressure, strain_rate and
 // packing_fraction (plus the free `density` alias); values are noisy so compression is not flattered.
 // "CPU" is the whole process (all threads), so it stays meaningful on a loaded machine.
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 
 #include <benchmark/benchmark.h>
 #include <unistd.h>

@@ -8,9 +8,9 @@
 #include <random>
 
 #include "engine/analysis.hpp"
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "tests/engine/test_scenes.hpp"
 
 using namespace furrow;

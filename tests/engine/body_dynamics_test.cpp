@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/test_scenes.hpp"
 

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/run.hpp"
 #include "engine/simulation.hpp"
 #include "test_scenes.hpp"

@@ -9,7 +9,7 @@
 
 #include "engine/analysis.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/test_scenes.hpp"
 

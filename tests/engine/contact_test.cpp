@@ -8,7 +8,7 @@
 #include <string>
 
 #include "engine/analysis.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/test_scenes.hpp"
 

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "engine/analysis.hpp"
-#include "engine/field_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 using namespace furrow;

@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "engine/analysis.hpp"
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/paper_claims.hpp"
 #include "tests/engine/test_scenes.hpp"

@@ -1,4 +1,6 @@
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
+
+#include "engine/io/atomic_file.hpp"
 
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>

@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "engine/analysis.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 using namespace furrow;

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 using namespace furrow;
 

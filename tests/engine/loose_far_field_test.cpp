@@ -26,8 +26,8 @@
 #include <thread>
 #include <vector>
 
-#include "engine/field_store.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/io/field_store.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 using namespace furrow;

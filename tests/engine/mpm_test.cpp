@@ -5,7 +5,7 @@
 #include <random>
 
 #include "engine/bodies.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/test_scenes.hpp"
 

@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/paper_claims.hpp"
 #include "tests/engine/test_scenes.hpp"

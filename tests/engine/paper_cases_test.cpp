@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "tests/engine/paper_cases_helpers.hpp"
 
 namespace furrow::paper {

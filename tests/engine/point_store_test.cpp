@@ -1,7 +1,7 @@
-// Point files (engine/point_store): the material points of a frame survive OpenVDB's reordering by
+// Point files (engine/io/point_store): the material points of a frame survive OpenVDB's reordering by
 // voxel, a run with outputs.points stores the solver's own particles, bad files are named in
 // errors, and the scene key is checked like the other outputs keys.
-#include "engine/point_store.hpp"
+#include "engine/io/point_store.hpp"
 
 #include <gtest/gtest.h>
 #include <openvdb/openvdb.h>
@@ -12,9 +12,9 @@
 #include <filesystem>
 #include <fstream>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "engine/run.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 #include "test_scenes.hpp"
 

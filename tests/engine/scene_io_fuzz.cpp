@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 namespace fs = std::filesystem;
 using furrow::SceneError;

@@ -1,6 +1,6 @@
 // Scene files: templates, round trips, estimates, overrides, and a table of malformed scenes that
 // must each be rejected with the JSON path at fault and what was expected.
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 
 using namespace furrow;

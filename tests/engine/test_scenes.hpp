@@ -1,6 +1,6 @@
 // Small programmatic scenes for engine tests (no JSON involved).
 #pragma once
-#include "engine/scene.hpp"
+#include "engine/scene/scene.hpp"
 
 namespace furrow::test_scenes {
 

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <memory>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "render/colormap.hpp"
 #include "render/field_movie.hpp"
 #include "render/force_series.hpp"

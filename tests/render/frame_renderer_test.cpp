@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "engine/field_store.hpp"
+#include "engine/io/field_store.hpp"
 #include "render/colormap.hpp"
 #include "render/frame_renderer.hpp"
 #include "tests/render/capture_output.hpp"

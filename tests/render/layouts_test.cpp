@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/force_series.hpp"
 #include "render/frame_renderer.hpp"
 #include "render/layouts.hpp"

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/scene.hpp"
-#include "engine/scene_io.hpp"
+#include "engine/scene/scene.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "tests/engine/test_scenes.hpp"
 
 namespace furrow::stability {

@@ -1,0 +1,432 @@
+// Contact of the grid with bodies and walls: node and cell_fraction contact (with the body's mass
+// field), a free body's response, the domain walls and the front/back walls' friction. Particle
+// contact is in contact_particles.cpp.
+#include <Eigen/Dense>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+#include "engine/bodies.hpp"
+#include "engine/scene/scene_io.hpp"
+#include "engine/shape_functions.hpp"
+#include "engine/simulation.hpp"
+#include "engine/simulation_detail.hpp"
+
+namespace furrow {
+
+namespace {
+
+// cell-fraction contact: the body as its own mass field (see contact_nodes). Its sample points
+// fill the body deeper than kBodyFieldInset cells, and deeper than kBodyFieldSideInset cells
+// across the body's motion (its faces along the motion, which never cross node lines, need no
+// smooth reach, and a field reaching past them made the body act wider: README, "Body
+// contact"), kBodySamplesPerCell per cell and axis, each with kBodyDensityRatio times the bed's
+// mean density. All four were chosen by measurement.
+constexpr double kBodyFieldInset = 0.5;
+constexpr double kBodyFieldSideInset = 1.0;
+constexpr int kBodySamplesPerCell = 4;
+constexpr double kBodyDensityRatio = 20.0;
+// cell-fraction contact starts where a point's surface comes this close to a body, in cells (the
+// onset target: nothing until the surfaces are within a quarter cell)
+constexpr double kTouchCells = 0.2;
+
+// Coulomb contact of a node velocity against a surface with outward normal n moving at vb.
+// Returns true if the node was in approaching contact and its velocity was changed.
+inline bool contact(Vec2& v, const Vec2& vb, const Vec2& n, double mu) {
+  const Vec2 rel = v - vb;
+  const double vn = rel.dot(n);
+  if (vn >= 0.0) return false;
+  Vec2 vt = rel - vn * n;
+  const double t = vt.norm();
+  if (t > 0.0) vt *= std::max(0.0, t + mu * vn) / t;  // vn < 0: friction removes up to mu|vn|
+  v = vb + vt;
+  return true;
+}
+
+}  // namespace
+
+// Sample points of each body's mass field (cell-fraction contact), fixed in the body's frame so
+// the field moves smoothly with it. The inset keeps the field's reach (the B-spline support of its
+// outermost points) near the surface; a body thinner than two insets keeps its inner half.
+void Simulation::sample_body_fields() {
+  const double dx = g_.dx, h = dx / kBodySamplesPerCell;
+  double mass = 0.0, volume = 0.0;
+  for (size_t p = 0; p < p_.size(); ++p) mass += p_.mass[p], volume += p_.volume[p];
+  const double density = volume > 0.0 ? kBodyDensityRatio * mass / volume : 0.0;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const auto [frame_lo, frame_hi] = shape_bounds_m(scene_.bodies[b].shape);  // in the body's frame
+    std::vector<std::pair<Vec2, double>> inside;  // point, depth below the surface (m)
+    double deepest = 0.0;
+    for (double y = frame_lo.y() + 0.5 * h; y < frame_hi.y(); y += h)
+      for (double x = frame_lo.x() + 0.5 * h; x < frame_hi.x(); x += h) {
+        const double depth = -shape_sdf(scene_.bodies[b].shape, Vec2(x, y));
+        if (depth <= 0.0) continue;
+        inside.emplace_back(Vec2(x, y), depth);
+        deepest = std::max(deepest, depth);
+      }
+    const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
+    const Shape& shape = scene_.bodies[b].shape;
+    // across the body's travel (a path that turns keeps the direction of its middle), in the
+    // body's frame; none for a body that spins: no one direction is across its travel. A body
+    // held at an angle keeps it (without, a plate tilted 0.001 degrees acted a side inset wider:
+    // +15% force on plate_intrusion)
+    const Body& body = scene_.bodies[b];
+    const bool spins = body.dynamics.free_angle || motion_max_angular_speed_rad_s(body.motion) > 0.0;
+    Vec2 travel = spins ? Vec2(0.0, 0.0) : travel_direction(scene_, body);
+    if (!spins && body.start_angle_rad != 0.0) {
+      const double c = std::cos(body.start_angle_rad), s = std::sin(body.start_angle_rad);
+      travel = Vec2(c * travel.x() + s * travel.y(), -s * travel.x() + c * travel.y());
+    }
+    const Vec2 across(-travel.y(), travel.x());
+    // distance from q to the surface along +-across (bisection on the SDF; the body is inside its box)
+    auto depth_across = [&](const Vec2& q) {
+      const double far = (frame_hi - frame_lo).norm();
+      double depth = far;
+      for (double sign : {-1.0, 1.0}) {
+        double in = 0.0, out = far;
+        for (int k = 0; k < 40; ++k) {
+          const double mid = 0.5 * (in + out);
+          (shape_sdf(shape, q + sign * mid * across) < 0.0 ? in : out) = mid;
+        }
+        depth = std::min(depth, out);
+      }
+      return depth;
+    };
+    std::vector<double> across_m(inside.size(), 0.0);
+    double widest = 0.0;
+    if (across.squaredNorm() > 0.0)
+      for (size_t k = 0; k < inside.size(); ++k) widest = std::max(widest, across_m[k] = depth_across(inside[k].first));
+    // as with the inset, a body too thin for it keeps its middle
+    const double side_inset = std::min(kBodyFieldSideInset * dx, 0.5 * widest);
+    std::vector<Vec2> samples;
+    for (size_t k = 0; k < inside.size(); ++k)
+      if (inside[k].second >= inset && across_m[k] >= side_inset) samples.push_back(inside[k].first);
+    body_samples_m_.push_back(std::move(samples));
+  }
+  body_sample_mass_kg_ = density * h * h;
+  body_node_full_kg_ = density * dx * dx;  // the field at a node whose whole stencil it fills
+}
+
+void Simulation::bodies_and_walls() {
+  if (!bodies_.empty()) (this->*contact_)();
+  contact_walls();
+}
+
+// Node contact: every grid node inside a body takes the body's normal velocity (Coulomb slip
+// along it). The constrained set grows by a node row each time a face crosses a node line, so
+// the force steps with a period of one cell.
+//
+// Cell-fraction contact (Fraction): the body is also a mass field on the grid, scattered from
+// sample points fixed in its frame (contact_cell_fraction), and a node takes the share
+// m_body / (m_body + m_media) of the correction, as multi-field contact of the media against a
+// body of finite mass would (Bardenhagen et al. 2001), scaled up to reach 1 where the field
+// covers the node fully, since a driven body has no finite mass. The share is a smooth function
+// of the body's position, so no node switches on at once as a face crosses a node line. The correction
+// itself is the mass-weighted mean of what each media point in the node's stencil asks of it: the
+// node's velocity held against the body along that point's own face normal (Coulomb slip along
+// it). One normal per node flips where the node crosses a thin body's medial axis (a node row of
+// a plate two cells thick, which then stopped holding the material below it: the larger part of
+// the node method's comb, and of a mass-gradient normal's); the points' normals do not, since
+// each point stays on its own side. Nodes act only once touched (contact_cell_fraction).
+template <bool Fraction>
+void Simulation::contact_nodes() {
+  const double dt = dt_s_, dx = g_.dx;
+  held_.resize(bodies_.size());
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const Body& body = scene_.bodies[b];
+    BodyState& s = bodies_[b];
+    const double mu = scene_.effects.body_friction ? body.friction : 0.0;
+    const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+    Vec2 impulse(0.0, 0.0);
+    double angular = 0.0;  // angular momentum the media gained about the body's origin
+    const bool free = body.dynamics.any_free();
+    // a free body: what each node's correction depends on the body's velocity (its projector)
+    if (free) held_[b].assign(size_t(i1 - i0 + 1) * size_t(j1 - j0 + 1), Vec3(0.0, 0.0, 0.0));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const size_t k = g_.index(i, j);
+        GridNode& n = g_.node[k];
+        const Vec2 xn(i * dx, j * dx), q = s.to_body(xn);
+        double share = 1.0;
+        const size_t c = size_t(j - j0) * size_t(i1 - i0 + 1) + size_t(i - i0);  // index in the body's box
+        if constexpr (Fraction) {
+          const double m_body = body_node_mass_kg_[b][c];
+          if (n.m <= 0.0 || m_body <= 0.0) {
+            touched_[b][k] = 0;  // out of the body's reach: must be touched again
+            continue;
+          }
+          if (!touched_[b][k]) continue;
+          // the multi-field share m_body / (m_body + m), scaled to reach 1 where the body's field
+          // covers the node fully (m_body = body_node_full_kg_): a driven body has no finite mass,
+          // and a share below 1 inside it let the material under it lag it (README, "Body contact")
+          share = std::min(1.0, m_body * (body_node_full_kg_ + n.m) / ((m_body + n.m) * body_node_full_kg_));
+        } else if (n.m <= 0.0 || shape_sdf(body.shape, q) >= 0.0) {
+          continue;
+        }
+        Vec2 v(n.vx, n.vy);
+        const Vec2 before = v;
+        if constexpr (Fraction) {
+          const double m_points = stencil_mass_kg_[b][c];
+          if (m_points <= 0.0) continue;
+          v += share * (stencil_dv_kg_m_s_[b][c] / m_points);
+        } else {
+          const Vec2 normal = s.to_world(shape_normal(body.shape, q, 1e-4 * dx));
+          if (!contact(v, s.velocity_at(xn), normal, mu)) continue;
+          if (free) held_[b][c] = Vec3(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
+        }
+        if constexpr (Fraction)
+          if (free) held_[b][c] = share * stencil_nn_[b][c] / stencil_mass_kg_[b][c];
+        const Vec2 dp = n.m * (v - before);
+        impulse += dp;
+        if (s.turns || free) angular += (xn - s.position_m).x() * dp.y() - (xn - s.position_m).y() * dp.x();
+        n.vx = v.x();
+        n.vy = v.y();
+      }
+    if (free) respond_free_body(b, impulse, angular);
+    s.force_N_per_m = -impulse / dt;
+    s.torque_N = -angular / dt;
+  }
+}
+
+// Cell-fraction contact acts only at nodes a material point has touched: a point whose surface is
+// within kTouchCells of the body marks the nodes of its stencil, and a node stays marked while both
+// the media and the body's field reach it. Without this, the body's field acts on material up to
+// a cell from the surface and the body feels the bed before it meets it.
+template <class K>
+void Simulation::contact_cell_fraction() {
+  const double dx = g_.dx, inv_dx = 1.0 / dx;
+  // a point reaches the nodes of the body's box (the body's box and two cells) from 1.5 cells out
+  const double reach = 3.5 * dx;
+  const int strips = int(strip_start_.size()) - 1;
+  touched_.resize(bodies_.size());
+  body_node_mass_kg_.resize(bodies_.size());
+  stencil_dv_kg_m_s_.resize(bodies_.size());
+  stencil_mass_kg_.resize(bodies_.size());
+  stencil_nn_.resize(bodies_.size());
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const BodyState& s = bodies_[b];
+    const Shape& shape = scene_.bodies[b].shape;
+    const double mu = scene_.effects.body_friction ? scene_.bodies[b].friction : 0.0;
+    auto& touched = touched_[b];
+    touched.resize(g_.node.size(), 0);
+    // only nodes contact_nodes() visits are marked, so it also clears every mark it leaves behind
+    const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+    const size_t width = size_t(i1 - i0 + 1), box_nodes = width * size_t(j1 - j0 + 1);
+    auto& dv = stencil_dv_kg_m_s_[b];
+    auto& m_points = stencil_mass_kg_[b];
+    dv.assign(box_nodes, Vec2(0.0, 0.0));
+    m_points.assign(box_nodes, 0.0);
+    const bool free = scene_.bodies[b].dynamics.any_free();
+    if (free) stencil_nn_[b].assign(box_nodes, Vec3(0.0, 0.0, 0.0));
+    // Both sums below run over bands of the box's node rows in parallel. Each band visits every
+    // sample and point in the same order as one pass would and adds only to its own rows, so each
+    // node's sum is the same whatever the bands: results are the same for any thread count (a
+    // point whose stencil spans two bands is worked out in both). Two bands per thread for balance,
+    // each at least four rows high; on one thread, one band and no work twice.
+    const int rows = j1 - j0 + 1, threads = tbb::this_task_arena::max_concurrency();
+    const int bands = threads == 1 ? 1 : std::clamp(std::min(rows / 4, 2 * threads), 1, rows);
+    auto band_rows = [&](int band) {
+      return std::pair<int, int>(j0 + int(int64_t(rows) * band / bands), j0 + int(int64_t(rows) * (band + 1) / bands) - 1);
+    };
+    // the body's field over its node box
+    auto& field = body_node_mass_kg_[b];
+    field.assign(box_nodes, 0.0);
+    tbb::parallel_for(0, bands, [&](int band) {
+      const auto [ra, rb] = band_rows(band);
+      for (const Vec2& q : body_samples_m_[b]) {
+        const Vec2 x = s.position_m + s.to_world(q);
+        const int base_y = K::base(x.y() * inv_dx);
+        if (base_y > rb || base_y + K::N - 1 < ra) continue;
+        double wx[K::N], wy[K::N], dw[K::N];
+        const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
+        const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
+        for (int j = std::max(by, ra); j <= std::min(by + K::N - 1, rb); ++j)
+          for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i)
+            field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
+      }
+    });
+    // each point in reach: marks its stencil if it touches the body, and adds to each node of its
+    // stencil (weight x mass) the change that holds the node against the body along the point's
+    // own face normal; points in strip order. Only nodes the body's field reaches: contact_nodes()
+    // acts on no other (and clears their marks).
+    const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
+    tbb::parallel_for(0, bands, [&](int band) {
+      const auto [ra, rb] = band_rows(band);
+      for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
+        const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
+        if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
+            r.y() > s.hi_m.y() + reach)
+          continue;
+        const int base_y = K::base(p_.y[p] * inv_dx);
+        if (base_y > rb || base_y + K::N - 1 < ra) continue;
+        double wx[K::N], wy[K::N], dw[K::N];
+        const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
+        const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
+        const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
+        const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
+        bool reached = false;  // over the whole stencil, not only this band's rows
+        for (int j = ja; j <= jb; ++j)
+          for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
+        if (!reached) continue;
+        const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
+        const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
+        const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
+        const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
+        const double mass = double(p_.mass[p]);
+        for (int j = std::max(ja, ra); j <= std::min(jb, rb); ++j)
+          for (int i = ia; i <= ib; ++i) {
+            const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
+            if (field[c] <= 0.0) continue;
+            if (touching) touched[k] = 1;
+            const double wm = wx[i - bx] * wy[j - by] * mass;
+            m_points[c] += wm;
+            Vec2 v(g_.node[k].vx, g_.node[k].vy);
+            const Vec2 v0 = v;
+            if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
+            dv[c] += wm * (v - v0);
+            if (free) stencil_nn_[b][c] += wm * nn;
+          }
+      }
+    });
+  }
+  contact_nodes<true>();
+}
+
+// Domain walls act on the nodes on and beyond each boundary line (walls lie on node lines, so
+// node contact is exact for them).
+void Simulation::contact_walls() {
+  const double dt = dt_s_;
+  const bool wall_friction = scene_.effects.wall_friction;
+  auto wall = [&](const Wall& w, int side, int i0, int i1, int j0, int j1, Vec2 n) {
+    Vec2 impulse(0.0, 0.0);
+    if (w.kind != Wall::Kind::Open)
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+          GridNode& node = g_.node[g_.index(i, j)];
+          if (node.m <= 0.0) continue;
+          Vec2 v(node.vx, node.vy);
+          const Vec2 before = v;
+          if (w.kind == Wall::Kind::Sticky)
+            v.setZero();
+          else
+            contact(v, Vec2(0.0, 0.0), n,
+                    w.kind == Wall::Kind::Friction && wall_friction ? w.friction : 0.0);
+          impulse += node.m * (v - before);
+          node.vx = v.x();
+          node.vy = v.y();
+        }
+    wall_forces_[side] = -impulse / dt;
+  };
+  const int P = Grid::kPad, nx = g_.nx, ny = g_.ny;
+  wall(scene_.walls.left, 0, -P, 0, -P, ny + P, Vec2(1, 0));
+  wall(scene_.walls.right, 1, nx, nx + P, -P, ny + P, Vec2(-1, 0));
+  wall(scene_.walls.bottom, 2, -P, nx + P, -P, 0, Vec2(0, 1));
+  wall(scene_.walls.top, 3, -P, nx + P, ny, ny + P, Vec2(0, -1));
+}
+
+// Friction of the front and back walls of a quasi-2D channel (scene walls.front_back): a point
+// pressing on them with sigma_zz < 0 loses up to dt 2 mu |sigma_zz| V / (gap m) of its in-plane
+// speed, against its motion (Coulomb: it may stop, never reverse). Applied to the points' velocities
+// after G2P, so the next P2G carries the loss and the FLIP update does not add it back.
+void Simulation::front_back_friction() {
+  const FrontBackWalls& w = scene_.walls.front_back;
+  const double k = 2.0 * w.friction * dt_s_ / w.gap_m;
+  auto& P = p_;
+  const Vec2 impulse = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<size_t>(0, P.size(), kGrain), Vec2(0.0, 0.0),
+      [&](const tbb::blocked_range<size_t>& r, Vec2 sum) {
+        for (size_t p = r.begin(); p < r.end(); ++p) {
+          const double sigma_zz = double(P.szz[p]) - P.pressure[p];
+          const double speed = std::hypot(P.vx[p], P.vy[p]);
+          if (sigma_zz >= 0.0 || speed == 0.0) continue;
+          const double keep = 1.0 - std::min(speed, k * -sigma_zz * P.volume[p] / P.mass[p]) / speed;
+          sum -= double(P.mass[p]) * (1.0 - keep) * Vec2(P.vx[p], P.vy[p]);
+          P.vx[p] *= keep;
+          P.vy[p] *= keep;
+        }
+        return sum;
+      },
+      [](const Vec2& a, const Vec2& b) { return Vec2(a + b); });
+  stats_.front_back_impulse_N_s_per_m = impulse;
+}
+
+// Two-way coupling of a body's free degrees of freedom u = (vx, vy, omega). The contact has just
+// held each node against the body moving at u0 and given the media `impulse` (and `angular`, about
+// the body's origin). Had the body moved at u0 + du, each held node would have changed by a further
+// P G du (P its projector, G du the body's velocity change at the node), the media gaining K du
+// with K = sum m G^T P G. The body's equation, M du = -impulse + dt F_applied + dt M g - K du, is
+// solved for du over the free degrees of freedom, and each node takes its P G du: the media gain
+// exactly what the body loses, so media + body change momentum only by gravity and the applied
+// loads, and a body light against the media it holds moves with them instead of overshooting
+// (K in the denominator), a heavy one barely responds (M).
+void Simulation::respond_free_body(size_t b, Vec2& impulse, double& angular) {
+  const BodyDynamics& d = scene_.bodies[b].dynamics;
+  BodyState& s = bodies_[b];
+  const double dt = dt_s_, dx = g_.dx;
+  const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+  const size_t width = size_t(i1 - i0 + 1);
+  const std::vector<Vec3>& held = held_[b];
+  auto jacobian = [](const Vec2& r) {  // body velocity change at r per du
+    Eigen::Matrix<double, 2, 3> G;
+    G << 1.0, 0.0, -r.y(), 0.0, 1.0, r.x();
+    return G;
+  };
+  auto projector = [](const Vec3& h) { return (Eigen::Matrix2d() << h.x(), h.y(), h.y(), h.z()).finished(); };
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const Vec3& h = held[size_t(j - j0) * width + size_t(i - i0)];
+      if (h.isZero()) continue;
+      const auto G = jacobian(Vec2(i * dx, j * dx) - s.position_m);
+      A += g_.node[g_.index(i, j)].m * (G.transpose() * projector(h) * G);
+    }
+  A(0, 0) += d.mass_kg_per_m;
+  A(1, 1) += d.mass_kg_per_m;
+  A(2, 2) += d.inertia_kg_m;
+  const Vec2 load = d.applied_force_N_per_m + d.mass_kg_per_m * gravity_;
+  const Vec3 rhs(dt * load.x() - impulse.x(), dt * load.y() - impulse.y(), dt * d.applied_torque_N - angular);
+  // the free degrees of freedom only: a prescribed one does not change here
+  const bool free[3] = {d.free_x, d.free_y, d.free_angle};
+  int index[3], nf = 0;
+  for (int k = 0; k < 3; ++k)
+    if (free[k]) index[nf++] = k;
+  Eigen::MatrixXd Af(nf, nf);
+  Eigen::VectorXd bf(nf);
+  for (int a = 0; a < nf; ++a) {
+    bf[a] = rhs[index[a]];
+    for (int c = 0; c < nf; ++c) Af(a, c) = A(index[a], index[c]);
+  }
+  const Eigen::VectorXd x = Af.ldlt().solve(bf);  // symmetric positive definite: mass > 0
+  Vec3 du(0.0, 0.0, 0.0);
+  for (int a = 0; a < nf; ++a) du[index[a]] = x[a];
+  // the held nodes follow the body's change
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      const Vec3& h = held[size_t(j - j0) * width + size_t(i - i0)];
+      if (h.isZero()) continue;
+      const Vec2 r = Vec2(i * dx, j * dx) - s.position_m;
+      const Vec2 dv = projector(h) * (jacobian(r) * du);
+      GridNode& n = g_.node[g_.index(i, j)];
+      n.vx += dv.x();
+      n.vy += dv.y();
+      const Vec2 dp = n.m * dv;
+      impulse += dp;
+      angular += r.x() * dp.y() - r.y() * dp.x();
+    }
+  s.velocity_m_s += du.head<2>();
+  s.omega_rad_s += du.z();
+}
+
+// the instances Simulation's constructor picks from
+template void Simulation::contact_nodes<false>();
+template void Simulation::contact_cell_fraction<LinearKernel>();
+template void Simulation::contact_cell_fraction<QuadraticKernel>();
+template void Simulation::contact_cell_fraction<CubicKernel>();
+
+}  // namespace furrow

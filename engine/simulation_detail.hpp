@@ -1,0 +1,61 @@
+// What the step's phase files share: the particle passes' task size, P2G's strips, a body's node
+// box. Internal to the engine; an unnamed namespace as simd4.hpp's, for the same reason.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <immintrin.h>
+#include <utility>
+
+#include "engine/simulation.hpp"
+
+namespace furrow {
+namespace {
+
+constexpr size_t kGrain = 4096;  // particles per TBB task
+
+// P2G's strips. A point whose stencil starts at node column `base` (the kernel's) belongs, when the
+// points are reordered, to strip s = floor(base / width) + 1: its nominal bases are
+// [width (s - 1), width s - 1]. Until the next reorder it may stray one column either way: its
+// window of bases [width (s - 1) - 1, width s] writes node columns up to width s + N - 1, which stay
+// left of what strip s + 2's window writes (width (s + 1) - 1) for width > N. So strips of one
+// colour never share a node, and P2G scatters a colour's strips in parallel without sorting.
+template <class K> struct StripWindow {
+  static constexpr int width = K::N + 1 > 4 ? K::N + 1 : 4;  // 4 node columns, 5 for cubic
+  static int count(int nx) { return nx / width + 3; }
+  static int of_base(int base, int strips) { return std::clamp((base + width) / width, 0, strips - 1); }  // base >= -2
+  static bool holds(int strip, int base) { return unsigned(base - (width * (strip - 1) - 1)) <= unsigned(width + 1); }
+#if defined(__AVX__)
+  // holds() for four points at once (strips and bases as 32-bit lanes): true when all four hold
+  static bool holds4(__m128i strip, __m128i base) {
+    const __m128i first = _mm_sub_epi32(_mm_mullo_epi32(strip, _mm_set1_epi32(width)), _mm_set1_epi32(width + 1));
+    const __m128i offset = _mm_sub_epi32(base, first), last = _mm_set1_epi32(width + 1);
+    return _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_max_epu32(offset, last), last)) == 0xffff;
+  }
+#endif
+};
+
+// The grid nodes a body's box covers, one node of margin, clipped to the padded grid. One
+// function for every contact pass, so a node one pass marks is a node another pass visits.
+struct NodeBox {
+  int i0, i1, j0, j1;
+};
+inline NodeBox body_node_box(const BodyState& s, const Grid& g) {
+  const double inv_dx = 1.0 / g.dx;
+  const Vec2 lo = (s.position_m + s.lo_m) * inv_dx, hi = (s.position_m + s.hi_m) * inv_dx;
+  return {std::max(-Grid::kPad, int(std::floor(lo.x())) - 1), std::min(g.nx + Grid::kPad, int(std::ceil(hi.x())) + 1),
+          std::max(-Grid::kPad, int(std::floor(lo.y())) - 1), std::min(g.ny + Grid::kPad, int(std::ceil(hi.y())) + 1)};
+}
+
+// The first and last P2G strips whose points may lie within `reach_m` of a body's box: a strip
+// either side more than the points there now, since a point may have strayed from its strip.
+template <class K> inline std::pair<int, int> body_strip_span(const BodyState& s, double reach_m, double inv_dx, int strips) {
+  using W = StripWindow<K>;
+  const int first = W::of_base(K::base((s.position_m.x() + s.lo_m.x() - reach_m) * inv_dx), strips);
+  const int last = W::of_base(K::base((s.position_m.x() + s.hi_m.x() + reach_m) * inv_dx), strips);
+  return {std::max(first - 1, 0), std::min(last + 1, strips - 1)};
+}
+
+}  // namespace
+}  // namespace furrow
