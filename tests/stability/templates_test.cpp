@@ -1,13 +1,13 @@
 // (10) The paper templates at their stiffest and fastest (issue 45): each paper case's template
-// (scenes/: cylinder_drag, plate_intrusion, plowing, loose_intrusion) with Young's modulus x 100
-// and the body's velocity x 10, with each transfer kernel, at the template's preview dx. E x 100
-// makes the waves 10x faster, so the scene's own CFL rule (dt = cfl dx / (c + v), the solver's
-// next_dt_s; nothing here sets dt) takes ~10x smaller steps, and a step of contact pushes on
-// material that answers with 100x the stress per unit strain; the bodies start (or, the plates,
-// arrive) at 10x the paper's speed, an impulsive start against the stiffest bed.
+// (scenes/: cylinder_drag, plate_intrusion and its pair two_plates, plowing, loose_intrusion) with
+// Young's modulus x 100 and the body's velocity x 10, with each transfer kernel, at the template's
+// preview dx. E x 100 makes the waves 10x faster, so the scene's own CFL rule (dt = cfl dx / (c + v),
+// the solver's next_dt_s; nothing here sets dt) takes ~10x smaller steps, and a step of contact
+// pushes on material that answers with 100x the stress per unit strain; the bodies start (or, the
+// plates, arrive) at 10x the paper's speed, an impulsive start against the stiffest bed.
 //
 // Each run goes until kStepsInContact steps after the first step in which a body feels the media
-// (the plates start 5 mm and 2 mm above their beds and first fall that gap), and every step goes
+// (the plates start 5 mm and 2 mm above their beds and first cross most of that gap), and every step goes
 // through the shared checker (stability_check.hpp):
 //   - finite: every per-point array, every grid node, every body and wall force;
 //   - no point centre more than dx/4 inside any body (the body's signed distance, shape_sdf);
@@ -19,12 +19,13 @@
 //     dissipation and wall friction only take energy out, so this is a bound, not a fit). A blow-up
 //     creates kinetic energy from nothing and crosses it within a few steps;
 //   - mass to round-off, every point inside the domain up to a quarter cell.
-// And the intrusion happened: the bodies did positive work on the media.
+// And the intrusion happened: the bodies did positive work on the media. Measured 2026-12-06: all
+// 15 pass, linear included (none skipped), peak KE / bound 0.23-0.42, deepest point 0.00052 dx
+// (plowing: one body step after the G2P safety net; 0 in the others); tests/README.md has the numbers.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -77,14 +78,6 @@ Scene stiff_fast(const std::string& name, ShapeFunction kernel) {
   return from_template(name, set);
 }
 
-// Known failures: measured, kept visible as skipped tests with what went wrong. Empty message:
-// the combination passes and asserts. FURROW_RUN_KNOWN_FAILURES=1 runs them anyway.
-const char* known_failure(const std::string& name, ShapeFunction kernel) {
-  (void)name;
-  (void)kernel;
-  return "";
-}
-
 }  // namespace
 
 class StiffFastTemplates : public ::testing::TestWithParam<std::tuple<const char*, ShapeFunction>> {};
@@ -92,9 +85,6 @@ class StiffFastTemplates : public ::testing::TestWithParam<std::tuple<const char
 TEST_P(StiffFastTemplates, PaperIntrusionStaysBounded) {
   const std::string name = std::get<0>(GetParam());
   const ShapeFunction kernel = std::get<1>(GetParam());
-  const char* known = known_failure(name, kernel);
-  if (*known && !std::getenv("FURROW_RUN_KNOWN_FAILURES")) GTEST_SKIP() << known;
-
   const Scene t = from_template(name, {});
   const Scene s = stiff_fast(name, kernel);
   ASSERT_EQ(s.solver.shape_function, kernel);
