@@ -222,7 +222,15 @@ std::pair<Vec2, Vec2> shape_bounds_m(const Shape& shape) {
 }
 
 Vec2 travel_direction(const Scene& scene, const Body& body) {
-  const Vec2 v = motion_velocity_m_s(body.motion, 0.5 * estimate_end_time_s(scene));
+  Vec2 v = motion_velocity_m_s(body.motion, 0.5 * estimate_end_time_s(scene));
+  const BodyDynamics& d = body.dynamics;
+  if (v.norm() == 0.0 && (d.free_x || d.free_y)) {
+    // a free body set down at rest (the footing) travels where its load pushes it, along the
+    // axes it is free in
+    Vec2 load = d.applied_force_N_per_m;
+    if (scene.effects.gravity) load += d.mass_kg_per_m * scene.effects.gravity_m_s2;
+    v = Vec2(d.free_x ? load.x() : 0.0, d.free_y ? load.y() : 0.0);
+  }
   return v.norm() > 0.0 ? Vec2(v / v.norm()) : Vec2(0.0, 0.0);
 }
 

@@ -85,8 +85,8 @@ double estimate_end_time_s(const Scene& scene);
 int64_t estimate_step_count(const Scene& scene);
 // What a run costs: particles x steps, the steps capped by solver.max_steps (cost predictions).
 double estimate_particle_steps(const Scene& scene);
-// A body's direction of travel (its velocity halfway through the run, unit), or zero if it does
-// not move then.
+// A body's direction of travel (its velocity halfway through the run, unit; for a free body that
+// starts at rest, its load along its free axes), or zero if it does not move then.
 Vec2 travel_direction(const Scene& scene, const Body& body);
 // A body's extent across its direction of travel, in cells; its smallest extent if it does not move.
 double body_cells_across(const Scene& scene, const Body& body);
