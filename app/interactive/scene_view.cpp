@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
+
 #include "engine/bodies.hpp"
 #include "render/imgui_offscreen.hpp"
 
@@ -61,9 +63,11 @@ void draw_scene(ImDrawList* dl, const Scene& s, const SceneLayout& l, float canv
   for (const auto& w : walls)
     if (w.w->kind != Wall::Kind::Open) dl->AddLine(px(l, w.a), px(l, w.b), wall_colour(w.w->kind), 4.0f);
   for (const Body& b : s.bodies) {
+    // at its start angle, turned about its origin as the solver turns it
+    const Eigen::Rotation2Dd turn(b.start_angle_rad);
     for (const auto& loop : shape_outline(b.shape)) {
       std::vector<ImVec2> pts;
-      for (const Vec2& q : loop) pts.push_back(px(l, q + b.start_m));
+      for (const Vec2& q : loop) pts.push_back(px(l, turn * q + b.start_m));
       // every part is convex (circle, box, convex polygon), so each loop fills as one polygon
       dl->AddConvexPolyFilled(pts.data(), int(pts.size()), IM_COL32(90, 96, 110, 255));
       dl->AddPolyline(pts.data(), int(pts.size()), IM_COL32(20, 20, 20, 255), ImDrawFlags_Closed, 1.5f);

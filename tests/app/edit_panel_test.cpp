@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -120,3 +121,24 @@ TEST(EditPanel, PreviewCapsTheSceneAndLeavesItValid) {
 }
 
 }  // namespace
+
+// A body is drawn at its start angle, as the solver places it: plate_intrusion's 0.1 x 0.02 m plate
+// turned 90 degrees covers 40 mm above its centre and not 40 mm beside it; unturned, the reverse.
+TEST(EditPanel, ABodyIsDrawnAtItsStartAngle) {
+  EditorState s = furrow::cli::open_scene_for_edit("plate_intrusion");
+  SceneView view(1280, 720);
+  const auto body_px = [&](const furrow::Scene& scene, const Eigen::Vector2d& offset_m) {
+    const furrow::render::RgbImage img = view.render(scene, furrow::cli::editor_panel(s));
+    const Eigen::Vector2d p = view.layout(scene).to_px(scene.bodies[0].start_m + offset_m);
+    const uint8_t* c = img.at(int(p.x()), int(p.y()));
+    return c[0] == 90 && c[1] == 96 && c[2] == 110;  // the body's fill
+  };
+  furrow::Scene scene = s.scene;
+  ASSERT_NEAR(scene.bodies[0].shape.size_m.x(), 0.1, 1e-12);
+  ASSERT_NEAR(scene.bodies[0].shape.size_m.y(), 0.02, 1e-12);
+  EXPECT_TRUE(body_px(scene, {0.04, 0.0}));
+  EXPECT_FALSE(body_px(scene, {0.0, 0.04}));
+  scene.bodies[0].start_angle_rad = M_PI / 2;
+  EXPECT_FALSE(body_px(scene, {0.04, 0.0}));
+  EXPECT_TRUE(body_px(scene, {0.0, 0.04}));
+}
