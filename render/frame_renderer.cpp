@@ -18,7 +18,9 @@
 #include <vtkContextScene.h>
 #include <vtkCoordinate.h>
 #include <vtkCellData.h>
+#include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
+#include <vtkStringArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkImageActor.h>
 #include <vtkImageData.h>
@@ -605,6 +607,20 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
       by->SetBehavior(vtkAxis::FIXED);
       bx->SetRange(a.x_lo, a.x_hi);
       by->SetRange(a.y_lo, a.y_hi);
+      // round ticks of our own: VTK's leave a torque of round-off size (a symmetric impactor:
+      // 1e-8 N m/m) with the 0 tick alone
+      {
+        const Ticks t = choose_ticks(a.y_lo, a.y_hi, 4, false);
+        vtkNew<vtkDoubleArray> at;
+        vtkNew<vtkStringArray> text;
+        for (size_t i = 0; i < t.values.size(); ++i) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%.3g", t.values[i]);
+          at->InsertNextValue(t.values[i]);
+          text->InsertNextValue(buf);
+        }
+        if (t.values.size() >= 2) by->SetCustomTickPositions(at, text);
+      }
       for (vtkAxis* ax2 : {bx, by}) {
         ax2->GetTitleProperties()->SetFontSize(label_px);
         ax2->GetTitleProperties()->SetColor(text_rgb);
