@@ -1,4 +1,5 @@
 // `furrow render` and `furrow demo`: argument handling only; drawing lives in render/.
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdio>
@@ -322,14 +323,31 @@ int render_main(const Parsed& p) {
   const fs::path forces = fs::path(runs.front()) / "forces.csv";
   if (!p.has("--no-panel") && !sheet && fs::exists(forces)) {
     render::ForcePanel panel = panel_of(0);
+    if (several_runs)  // each trace labelled like its run's panel
+      for (auto& row : panel.rows)
+        for (auto& s : row.series) s.label = panels_style.fields[0].title + ": " + s.label;
     // several runs: one trace per run, labelled like its panel
     for (size_t r = 1; r < runs.size() && !panel.series.empty(); ++r) {
       const fs::path f = fs::path(runs[r]) / "forces.csv";
       if (!fs::exists(f)) continue;
-      for (auto s : panel_of(r).series) {
+      const render::ForcePanel other = panel_of(r);
+      for (auto s : other.series) {
         s.label = panels_style.fields[r].title + ": " + s.label;
         panel.series.push_back(s);
       }
+      // torque, depth, ...: the same rows, in their order (torque, depth, speed, angle)
+      for (const auto& row : other.rows) {
+        auto mine = std::find_if(panel.rows.begin(), panel.rows.end(), [&](const auto& m) { return m.key == row.key; });
+        if (mine == panel.rows.end()) mine = panel.rows.insert(panel.rows.end(), render::MotionRow{row.key, row.y_label, row.movie, {}});
+        for (auto s : row.series) {
+          s.label = panels_style.fields[r].title + ": " + s.label;
+          mine->series.push_back(s);
+        }
+      }
+      const std::vector<std::string> order = {"torque", "depth", "speed", "angle"};
+      std::stable_sort(panel.rows.begin(), panel.rows.end(), [&](const auto& a, const auto& b) {
+        return std::find(order.begin(), order.end(), a.key) < std::find(order.begin(), order.end(), b.key);
+      });
     }
     if (several_runs)
       for (size_t k = 0; k < panel.series.size() && panel.series[k].label.find(": ") == std::string::npos; ++k)

@@ -1,6 +1,7 @@
 #include "render/force_series.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
 #include <cmath>
 #include <cstdlib>
@@ -8,6 +9,10 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+
+#include "engine/scene/scene_io.hpp"
+
+namespace fs = std::filesystem;
 
 namespace furrow::render {
 
@@ -28,7 +33,63 @@ std::vector<std::string> split(const std::string& line) {
 
 struct Sample {
   double t, x, y, fx, fy;
+  double torque = 0, angle_deg = 0, vx = 0, vy = 0, omega = 0;  // 0 in a forces.csv without them
 };
+
+// What scene.json beside forces.csv says of a body's degrees of freedom.
+struct BodyDofs {
+  bool known = false, turns = false, free_x = false, free_y = false;
+};
+
+std::map<std::string, BodyDofs> scene_dofs(const std::string& forces_path) {
+  std::map<std::string, BodyDofs> out;
+  const fs::path scene = fs::path(forces_path).parent_path() / "scene.json";
+  if (!fs::exists(scene)) return out;
+  try {
+    for (const Body& b : load_scene(scene.string()).bodies)
+      out[b.name] = {true, b.rotates(), b.dynamics.free_x, b.dynamics.free_y};
+  } catch (const std::exception&) {
+    // an unreadable scene.json: the rows follow the data alone
+  }
+  return out;
+}
+}  // namespace
+
+namespace {
+// The rows of the bodies that turn or are free. A body turns when scene.json says so (a start
+// angle, an angular velocity, a free angle) or, without scene.json, when its angle or angular
+// velocity is ever nonzero; which DOFs are free only scene.json says.
+std::vector<MotionRow> motion_rows(const std::vector<std::string>& order,
+                                   std::map<std::string, std::vector<Sample>>& bodies,
+                                   const std::map<std::string, BodyDofs>& dofs) {
+  MotionRow torque{"torque", "torque (N m/m)", true, {}}, depth{"depth", "depth below start (mm)", true, {}};
+  MotionRow speed{"speed", "speed (m/s)", false, {}}, angle{"angle", "angle (deg)", false, {}};
+  for (const std::string& name : order) {
+    const std::vector<Sample>& s = bodies[name];
+    BodyDofs d;
+    if (const auto it = dofs.find(name); it != dofs.end()) d = it->second;
+    if (!d.known)
+      for (const Sample& q : s) d.turns |= q.omega != 0.0 || q.angle_deg != 0.0;
+    if (!d.turns && !d.free_x && !d.free_y) continue;
+    ForceSeries tq, dp, sp, an;
+    tq.label = dp.label = sp.label = an.label = name;
+    for (const Sample& q : s) {
+      for (ForceSeries* f : {&tq, &dp, &sp, &an}) f->t_s.push_back(q.t), f->x.push_back(q.t);
+      tq.y.push_back(q.torque);
+      dp.y.push_back(1e3 * (s.front().y - q.y));
+      sp.y.push_back(std::hypot(q.vx, q.vy));
+      an.y.push_back(q.angle_deg);
+    }
+    torque.series.push_back(std::move(tq));
+    if (d.free_y) depth.series.push_back(std::move(dp));
+    if (d.free_x || d.free_y) speed.series.push_back(std::move(sp));
+    angle.series.push_back(std::move(an));
+  }
+  std::vector<MotionRow> rows;
+  for (MotionRow* r : {&torque, &depth, &speed, &angle})
+    if (!r->series.empty()) rows.push_back(std::move(*r));
+  return rows;
+}
 }  // namespace
 
 ForcePanel read_force_panel(const std::string& path) {
@@ -46,6 +107,16 @@ ForcePanel read_force_panel(const std::string& path) {
     if (col[k] < 0)
       throw std::runtime_error(path + ":1: missing column '" + wanted[k] +
                                "' (expected header t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m)");
+  }
+  // the motion columns (forces.csv since free bodies); older files have none
+  const char* motion_names[] = {"torque_N_m_per_m", "angle_deg", "vx_m_s", "vy_m_s", "omega_rad_s"};
+  int mcol[5];
+  bool has_motion = true;
+  for (int k = 0; k < 5; ++k) {
+    mcol[k] = -1;
+    for (size_t c = 0; c < header.size(); ++c)
+      if (header[c] == motion_names[k]) mcol[k] = int(c);
+    has_motion &= mcol[k] >= 0;
   }
   std::vector<std::string> order;
   std::map<std::string, std::vector<Sample>> bodies;
@@ -67,9 +138,18 @@ ForcePanel read_force_panel(const std::string& path) {
         throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column '" + wanted[k] +
                                  "' must be a finite number, got '" + s + "'");
     }
+    double m[5] = {0, 0, 0, 0, 0};
+    for (int k = 0; k < 5 && has_motion; ++k) {
+      const std::string& c = cells[size_t(mcol[k])];
+      char* end = nullptr;
+      m[k] = std::strtod(c.c_str(), &end);
+      if (c.empty() || *end != '\0' || !std::isfinite(m[k]))
+        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column '" + motion_names[k] +
+                                 "' must be a finite number, got '" + c + "'");
+    }
     const std::string& name = cells[size_t(col[1])];
     if (!bodies.count(name)) order.push_back(name);
-    bodies[name].push_back({v[0], v[2], v[3], v[4], v[5]});
+    bodies[name].push_back({v[0], v[2], v[3], v[4], v[5], m[0], m[1], m[2], m[3], m[4]});
   }
 
   ForcePanel panel;
@@ -97,6 +177,7 @@ ForcePanel read_force_panel(const std::string& path) {
     }
     panel.series.push_back(std::move(out));
   }
+  if (has_motion) panel.rows = motion_rows(order, bodies, scene_dofs(path));
   return panel;
 }
 

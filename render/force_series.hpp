@@ -5,6 +5,14 @@
 // component, -F . d, with d the unit direction of the body's overall travel (first to last
 // position). For a plate pushed down that is Fy; for a body dragged along +x it is -Fx (drag).
 // If no body moves, the panel plots |F| against time instead.
+//
+// A forces.csv with the motion columns (torque_N_m_per_m, angle_deg, vx_m_s, vy_m_s, omega_rad_s)
+// also gives ForcePanel::rows for each body that turns or has a free DOF (scene.json beside
+// forces.csv says which; without it a body turns when its angle or angular velocity is ever
+// nonzero): torque (N m/m) of every such body and depth below its start (mm, positive down) of a
+// body with free y, both drawn under the force chart; speed (m/s) of a body with free x or y and
+// its angle (deg), for the inspector. An older forces.csv, or a run whose bodies all follow a
+// motion without turning, has no rows and renders as before.
 #pragma once
 #include <string>
 

@@ -18,7 +18,9 @@
 #include <vtkContextScene.h>
 #include <vtkCoordinate.h>
 #include <vtkCellData.h>
+#include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
+#include <vtkStringArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkImageActor.h>
 #include <vtkImageData.h>
@@ -234,6 +236,13 @@ struct FrameRenderer::Pipeline {
   vtkNew<vtkContextActor> chart_actor;
   vtkNew<vtkChartXY> chart;
   std::vector<vtkSmartPointer<vtkTable>> line_tables, marker_tables;
+  // the movie rows under the force chart (torque, depth against time)
+  struct RowPlot {
+    size_t row = 0, series = 0;  // indices into ForcePanel::rows and its series
+    vtkSmartPointer<vtkTable> line, marker;
+  };
+  std::vector<vtkSmartPointer<vtkChartXY>> row_charts;
+  std::vector<RowPlot> row_plots;
 
   Pipeline(int w, int h) : window(w, h) {}
 };
@@ -487,7 +496,13 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
 
     // fill the panel but leave a little air above the chart title
     p.chart->SetLayoutStrategy(vtkChart::FILL_RECT);
-    p.chart->SetSize(vtkRectf(0.f, 0.f, float(W - fa_w), float(H - std::lround(0.03 * H))));
+    std::vector<size_t> rows;  // the movie rows, each a small chart under the force chart
+    for (size_t r = 0; r < fp.rows.size(); ++r)
+      if (fp.rows[r].movie && !fp.rows[r].series.empty()) rows.push_back(r);
+    const float chart_h = float(H - std::lround(0.03 * H));
+    const float force_h = rows.empty() ? chart_h : std::round(0.5f * chart_h);
+    const float row_h = rows.empty() ? 0.f : std::floor((chart_h - force_h) / float(rows.size()));
+    p.chart->SetSize(vtkRectf(0.f, chart_h - force_h, float(W - fa_w), force_h));
     p.chart->GetTitleProperties()->SetFontSize(title_px - 2);
     p.chart->GetTitleProperties()->SetColor(text_rgb);
     const ForceAxes axes = force_panel_axes(fp);
@@ -546,6 +561,76 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
     }
     p.chart->SetShowLegend(colour > 1);
     if (colour > 1) p.chart->GetLegend()->GetLabelProperties()->SetFontSize(label_px - 2);
+
+    // rows: each body in the colour of its force trace, against time; the chart's own legend names them
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const MotionRow& row = fp.rows[rows[k]];
+      auto chart = vtkSmartPointer<vtkChartXY>::New();
+      chart->SetLayoutStrategy(vtkChart::FILL_RECT);
+      const float y0 = float(rows.size() - 1 - k) * row_h;
+      chart->SetSize(vtkRectf(0.f, y0, float(W - fa_w), row_h));
+      layout_.panel_rows.push_back({fa_w, H - int(std::lround(y0 + row_h)), W, H - int(std::lround(y0))});
+      for (size_t s = 0; s < row.series.size(); ++s) {
+        const ForceSeries& ser = row.series[s];
+        size_t c_index = s, n = 0;
+        for (const ForceSeries& f : fp.series) {
+          if (f.faint) continue;
+          if (f.label == ser.label) {
+            c_index = n;
+            break;
+          }
+          ++n;
+        }
+        const std::array<unsigned char, 3> c = kSeriesColors[c_index % 4];
+        auto line_t = make_xy_table("time (s)", ser.label.empty() ? "body " + std::to_string(s) : ser.label);
+        auto mark_t = make_xy_table("time (s)", "now");
+        vtkPlot* line = chart->AddPlot(vtkChart::LINE);
+        line->SetInputData(line_t, 0, 1);
+        line->SetColor(c[0], c[1], c[2], 255);
+        line->SetWidth(float(std::max(1.5, 2.5 * font_scale)));
+        vtkPlot* mark = chart->AddPlot(vtkChart::POINTS);
+        mark->SetInputData(mark_t, 0, 1);
+        mark->SetColor(c[0], c[1], c[2], 255);
+        mark->SetLegendVisibility(false);
+        if (auto* pts = vtkPlotPoints::SafeDownCast(mark)) {
+          pts->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+          pts->SetMarkerSize(float(std::max(6.0, 12.0 * font_scale)));
+        }
+        p.row_plots.push_back({rows[k], s, line_t, mark_t});
+      }
+      const ForceAxes a = force_axes(row.series.data(), row.series.size());
+      vtkAxis* bx = chart->GetAxis(vtkAxis::BOTTOM);
+      vtkAxis* by = chart->GetAxis(vtkAxis::LEFT);
+      bx->SetTitle("time (s)");
+      by->SetTitle(row.y_label);
+      bx->SetBehavior(vtkAxis::FIXED);
+      by->SetBehavior(vtkAxis::FIXED);
+      bx->SetRange(a.x_lo, a.x_hi);
+      by->SetRange(a.y_lo, a.y_hi);
+      // round ticks of our own: VTK's leave a torque of round-off size (a symmetric impactor:
+      // 1e-8 N m/m) with the 0 tick alone
+      {
+        const Ticks t = choose_ticks(a.y_lo, a.y_hi, 4, false);
+        vtkNew<vtkDoubleArray> at;
+        vtkNew<vtkStringArray> text;
+        for (size_t i = 0; i < t.values.size(); ++i) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%.3g", t.values[i]);
+          at->InsertNextValue(t.values[i]);
+          text->InsertNextValue(buf);
+        }
+        if (t.values.size() >= 2) by->SetCustomTickPositions(at, text);
+      }
+      for (vtkAxis* ax2 : {bx, by}) {
+        ax2->GetTitleProperties()->SetFontSize(label_px);
+        ax2->GetTitleProperties()->SetColor(text_rgb);
+        ax2->GetLabelProperties()->SetFontSize(label_px - 2);
+        ax2->GetLabelProperties()->SetColor(text_rgb);
+      }
+      chart->SetShowLegend(false);
+      p.chart_actor->GetScene()->AddItem(chart);
+      p.row_charts.push_back(chart);
+    }
   }
 }
 
@@ -733,6 +818,13 @@ RgbImage FrameRenderer::render(const FieldFrame& frame, const FrameOverlay* over
       }
     }
     p.chart->RecalculateBounds();
+    for (const Pipeline::RowPlot& rp : p.row_plots) {
+      series_until(style_.panel->rows[rp.row].series[rp.series], frame.time_s, x, y);
+      set_xy_rows(rp.line, x, y);
+      if (x.empty()) set_xy_rows(rp.marker, {}, {});
+      else set_xy_rows(rp.marker, {x.back()}, {y.back()});
+    }
+    for (auto& c : p.row_charts) c->RecalculateBounds();
   }
   return p.window.capture();
 }

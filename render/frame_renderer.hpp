@@ -69,11 +69,22 @@ struct ForceSeries {
   std::vector<double> t_s, x, y;  // x, y in the panel's display units
 };
 
+// One quantity of the bodies that turn or are free against time (x = t_s): torque, depth, ...
+struct MotionRow {
+  std::string key;      // "torque", "depth", "speed", "angle"
+  std::string y_label;  // with its unit, e.g. "torque (N m/m)"
+  bool movie = false;   // drawn as a row under the force chart; the rest only in the inspector
+  std::vector<ForceSeries> series;  // labels are body names, as in the force chart
+};
+
 struct ForcePanel {
   std::string title = "Force on bodies";
   std::string x_label = "displacement (mm)";
   std::string y_label = "resisting force (N/m)";
   std::vector<ForceSeries> series;
+  // Empty unless a body turns or is free (render/force_series.hpp); without a `movie` row the
+  // panel is the force chart alone, as it was before these rows existed.
+  std::vector<MotionRow> rows;
 };
 
 // The panel's axes, fixed over the whole series so the plot does not jump between frames. The
@@ -138,6 +149,8 @@ struct FrameLayout {
   std::string colorbar_unit;         // unit the labels read in, e.g. "kPa"
   int time_x0 = 0, time_y0 = 0, time_x1 = 0, time_y1 = 0;  // box the time stamp is drawn in
   int panel_x0 = 0, panel_x1 = 0;                          // 0, 0 when there is no panel
+  // The charts of the panel's movie rows under the force chart (x0, y0, x1, y1), top to bottom.
+  std::vector<std::array<int, 4>> panel_rows;
   // Pixel (x right, y down) of a world point.
   Eigen::Vector2d to_pixel(const Eigen::Vector2d& p_m) const {
     return {bed_x0 + (p_m.x() - bed_origin_m.x()) * px_per_m, bed_y1 - (p_m.y() - bed_origin_m.y()) * px_per_m};

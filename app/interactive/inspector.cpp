@@ -31,7 +31,9 @@ const char* const kInspectScriptHelp =
     "  length X0 Y0 X1 Y1               the distance (m)\n"
     "  screenshot PATH                  PNG of the view: the frame + the inspector panel\n"
     "  wedge                            the frame's rigid wedge as run.json's analysis stored it\n"
-    "  wedge on|off                     show or hide the wedge overlay (flank lines, apex angle)\n";
+    "  wedge on|off                     show or hide the wedge overlay (flank lines, apex angle)\n"
+    "  plot torque|depth|speed|angle    plot this against time for the bodies that turn or are free\n"
+    "                                   (torque N m/m, depth below the start mm, speed m/s, angle deg)\n";
 
 
 std::optional<InspectAction> parse_inspect_line(const std::string& line, std::string* error) {
@@ -93,7 +95,12 @@ std::optional<InspectAction> parse_inspect_line(const std::string& line, std::st
     if (w.size() == 2 && (w[1] == "on" || w[1] == "off")) return ShowWedge{w[1] == "on"};
     return *error = "expected 'wedge' or 'wedge on|off'", std::nullopt;
   }
-  *error = "expected one of field, frame, time, probe, profile, angle, length, screenshot, wedge";
+  if (verb == "plot") {
+    if (w.size() != 2 || (w[1] != "torque" && w[1] != "depth" && w[1] != "speed" && w[1] != "angle"))
+      return *error = "expected 'plot torque|depth|speed|angle'", std::nullopt;
+    return PlotMotion{w[1]};
+  }
+  *error = "expected one of field, frame, time, probe, profile, angle, length, screenshot, wedge, plot";
   return std::nullopt;
 }
 
@@ -218,6 +225,7 @@ InspectorState open_run(const std::string& run_dir, const std::string& field) {
   if (fs::exists(forces)) {
     ForcePanel panel = read_force_panel(forces.string());
     if (!panel.series.empty()) s.forces = panel;
+    if (!panel.series.empty() && !panel.rows.empty()) s.motion = panel.rows.front().key;
   }
   return s;
 }
@@ -312,6 +320,16 @@ size_t nearest_time(const InspectorState& s, double t) {
   return best;
 }
 
+// Linear interpolation of a series' y at time t (its ends outside them).
+double y_at_time(const ForceSeries& s, double t) {
+  if (s.t_s.empty()) return NAN;
+  if (t <= s.t_s.front()) return s.y.front();
+  for (size_t k = 1; k < s.t_s.size(); ++k)
+    if (t <= s.t_s[k])
+      return s.y[k - 1] + (s.y[k] - s.y[k - 1]) * (t - s.t_s[k - 1]) / std::max(1e-300, s.t_s[k] - s.t_s[k - 1]);
+  return s.y.back();
+}
+
 std::string short_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -334,7 +352,26 @@ nlohmann::json write_screenshot(const InspectorState& s, const std::string& path
 
 nlohmann::json apply_action(InspectorState& s, const InspectAction& action, InspectorView* view) {
   nlohmann::json r;
-  if (auto* a = std::get_if<SelectField>(&action)) {
+  if (auto* a = std::get_if<PlotMotion>(&action)) {
+    const MotionRow* row = nullptr;
+    std::string have;
+    if (s.forces)
+      for (const MotionRow& m : s.forces->rows) {
+        if (m.key == a->key) row = &m;
+        have += (have.empty() ? "" : ", ") + m.key;
+      }
+    if (!row)
+      throw std::runtime_error(s.run_dir + "/forces.csv has no " + a->key + " to plot (" +
+                               (have.empty() ? "no body turns or is free, or forces.csv predates torque and angle"
+                                             : "it has " + have) + ")");
+    s.motion = a->key;
+    // each body's value at the current frame's time
+    nlohmann::json values = nlohmann::json::object();
+    for (const ForceSeries& ser : row->series) values[ser.label] = y_at_time(ser, s.frame.time_s);
+    r = {{"action", "plot"}, {"quantity", a->key}, {"label", row->y_label}, {"values", values}};
+    r.update(where(s));
+    s.notes.push_back("plot " + row->y_label);
+  } else if (auto* a = std::get_if<SelectField>(&action)) {
     select_field(s, a->name);
     const FieldRange& range = s.ranges.at(s.field);
     r = {{"action", "field"}, {"field", s.field}, {"unit", find_field(s.field)->unit},
@@ -471,6 +508,34 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
       if (std::isfinite(axes.clipped_lo)) ImGui::Text("low %.4g off the chart", axes.clipped_lo);
     }
     ImGui::Separator();
+    // bodies that turn or are free: the picked quantity against time, the current time marked
+    if (!fp.rows.empty()) {
+      const MotionRow* row = &fp.rows.front();
+      for (const MotionRow& m : fp.rows)
+        if (m.key == s.motion) row = &m;
+      if (ImGui::BeginCombo("plot", row->key.c_str())) {
+        for (const MotionRow& m : fp.rows)
+          if (ImGui::Selectable(m.key.c_str(), &m == row)) changes.push_back(PlotMotion{m.key});
+        ImGui::EndCombo();
+      }
+      for (const ForceSeries& ser : row->series) {
+        if (ser.x.size() < 2) continue;
+        const ForceAxes axes = force_axes(&ser, 1);
+        const std::vector<float> ys = resample(ser, 120, axes.x_lo, axes.x_hi);
+        ImGui::Text("%s: %s", ser.label.c_str(), row->y_label.c_str());
+        ImGui::PushID(&ser);
+        ImGui::PlotLines("##motion", ys.data(), int(ys.size()), 0, nullptr, float(axes.y_lo), float(axes.y_hi),
+                         ImVec2(width - 20, 0.16f * height));
+        ImGui::PopID();
+        const ImVec2 r0 = ImGui::GetItemRectMin(), r1 = ImGui::GetItemRectMax();
+        const ImVec2 pad = ImGui::GetStyle().FramePadding;
+        const double u = (axes.x_hi > axes.x_lo) ? (s.frame.time_s - axes.x_lo) / (axes.x_hi - axes.x_lo) : 0.0;
+        const float px = r0.x + pad.x + float(std::clamp(u, 0.0, 1.0)) * (r1.x - r0.x - 2 * pad.x);
+        ImGui::GetWindowDrawList()->AddLine(ImVec2(px, r0.y), ImVec2(px, r1.y), IM_COL32(255, 200, 0, 255), 2.0f);
+        ImGui::Text("time (s): %.4g .. %.4g   now %.4g", axes.x_lo, axes.x_hi, y_at_time(ser, s.frame.time_s));
+      }
+      ImGui::Separator();
+    }
   }
   for (const auto& n : s.notes) ImGui::TextWrapped("%s", n.c_str());
   ImGui::End();

@@ -33,8 +33,11 @@ struct Length { Eigen::Vector2d a_m{0, 0}, b_m{0, 0}; };
 struct Screenshot { std::string path; };
 struct ReportWedge {};               // the current frame's wedge as run.json stored it
 struct ShowWedge { bool on = true; };  // the wedge overlay on or off
-using InspectAction =
-    std::variant<SelectField, GoToFrame, GoToTime, Probe, Profile, Angle, Length, Screenshot, ReportWedge, ShowWedge>;
+// The quantity plotted against time under the force plot for the bodies that turn or are free:
+// torque, depth, speed or angle (ForcePanel::rows)
+struct PlotMotion { std::string key; };
+using InspectAction = std::variant<SelectField, GoToFrame, GoToTime, Probe, Profile, Angle, Length, Screenshot,
+                                   ReportWedge, ShowWedge, PlotMotion>;
 
 // One script line as an action. Returns an error text (what was expected, what was found) instead
 // when the line is not one; blank lines and '#' comments give std::nullopt with an empty error.
@@ -59,6 +62,7 @@ struct InspectorState {
   std::vector<std::string> fields;               // stored in the run (registry order)
   std::map<std::string, FieldRange> ranges;      // colour range per field, fixed over the run
   std::optional<ForcePanel> forces;              // from forces.csv when present
+  std::string motion;  // the key of the forces->rows entry plotted against time ("" when it has none)
   size_t current = 0;                            // index into frame_paths
   std::string field;
   FieldFrame frame;                              // the current frame

@@ -300,3 +300,34 @@ TEST_F(InspectCli, WindowUnderXvfbReplaysAScriptAndScreenshotsTheWindow) {
 }
 
 }  // namespace
+
+// A body that turns (forces.csv with torque and angle): `plot torque` and `plot angle` give each
+// body's value at the frame's time; depth needs a free y, which only scene.json says, so without
+// it the error names what there is; a forces.csv before those columns has none at all.
+TEST_F(InspectCli, PlotTorqueAndAngleOfABodyThatTurns) {
+  const StoredRun stored(dir_ / "run");
+  {
+    std::ofstream csv(dir_ / "run" / "forces.csv");
+    csv << "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m,torque_N_m_per_m,angle_deg,vx_m_s,vy_m_s,omega_rad_s\n";
+    for (int k = 0; k <= 30; ++k)
+      csv << 0.001 * k << ",plate,0.2," << 0.2 - 0.0002 * k << ",0," << 40.0 * k << "," << -0.1 * k << "," << -2.0 * k
+          << ",0,-0.2,-1\n";
+  }
+  auto r = run({"inspect", (dir_ / "run").string(), "--headless", "--script",
+                script("time 0.01\nplot angle\nplot torque\nscreenshot " + path("shot.png") + "\nplot depth\n")});
+  EXPECT_EQ(r.status, 1) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), 4u) << r.out;
+  EXPECT_EQ(out[1].at("quantity"), "angle");
+  EXPECT_NEAR(out[1].at("values").at("plate").get<double>(), -20.0, 1e-6);  // t = 0.01 s: sample 10
+  EXPECT_EQ(out[2].at("label"), "torque (N m/m)");
+  EXPECT_NEAR(out[2].at("values").at("plate").get<double>(), -1.0, 1e-6);
+  EXPECT_TRUE(std::filesystem::exists(path("shot.png")));
+  EXPECT_NE(r.err.find("script.txt:5: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("has no depth to plot (it has torque, angle)"), std::string::npos) << r.err;
+  // the old columns: nothing to plot
+  std::ofstream(dir_ / "run" / "forces.csv") << "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m\n0,plate,0.2,0.2,0,0\n0.01,plate,0.2,0.19,0,4\n";
+  r = run({"inspect", (dir_ / "run").string(), "--headless", "--script", script("plot torque\n")});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("no body turns or is free"), std::string::npos) << r.err;
+}

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "engine/io/field_store.hpp"
 #include "render/colormap.hpp"
@@ -184,5 +185,60 @@ TEST(ForceSeries, ResistingForceAlongTravelAgainstDisplacement) {
     EXPECT_NE(std::string(e.what()).find("y_m"), std::string::npos) << e.what();
   }
   EXPECT_THROW(read_force_panel(write_csv(dir, "nohdr.csv", "t,body,x,y\n")), std::runtime_error);
+  fs::remove_all(dir);
+}
+
+// forces.csv with the motion columns: a body that turns gets torque and angle rows; which DOFs are
+// free only scene.json says (depth for a free y, speed for a free x or y); a plate that only
+// translates gets none, so its panel stays the force chart alone.
+TEST(ForceSeries, TorqueAndDepthRowsForBodiesThatTurnOrAreFree) {
+  const fs::path dir = fs::temp_directory_path() / ("furrow_motion_" + std::to_string(::getpid()));
+  std::string csv = "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m,torque_N_m_per_m,angle_deg,vx_m_s,vy_m_s,omega_rad_s\n";
+  for (int k = 0; k < 5; ++k) {
+    const std::string t = std::to_string(0.01 * k);
+    csv += t + ",impactor,0.12," + std::to_string(0.132 - 0.002 * k) + ",0,5," + std::to_string(-0.1 * k) + "," +
+           std::to_string(-3.0 * k) + ",0,-0.2,-1\n";
+    csv += t + ",plate,0.5," + std::to_string(0.3 - 0.001 * k) + ",0,9,0.01,0,0,-0.1,0\n";
+  }
+  const ForcePanel data_only = read_force_panel(write_csv(dir / "a", "forces.csv", csv));
+  ASSERT_EQ(data_only.series.size(), 2u);
+  ASSERT_EQ(data_only.rows.size(), 2u);  // no scene.json: the impactor turns, free DOFs unknown
+  EXPECT_EQ(data_only.rows[0].key, "torque");
+  EXPECT_EQ(data_only.rows[0].y_label, "torque (N m/m)");
+  EXPECT_TRUE(data_only.rows[0].movie);
+  ASSERT_EQ(data_only.rows[0].series.size(), 1u);
+  EXPECT_EQ(data_only.rows[0].series[0].label, "impactor");
+  EXPECT_NEAR(data_only.rows[0].series[0].x[3], 0.03, 1e-12);  // against time (s)
+  EXPECT_NEAR(data_only.rows[0].series[0].y[3], -0.3, 1e-12);
+  EXPECT_EQ(data_only.rows[1].key, "angle");
+  EXPECT_FALSE(data_only.rows[1].movie);
+
+  // scene.json beside it: the impactor template (x, y and angle free)
+  std::ifstream in(std::string(FURROW_SOURCE_DIR) + "/scenes/impactor.json");
+  std::stringstream scene;
+  scene << in.rdbuf();
+  write_csv(dir / "b", "scene.json", scene.str());
+  const ForcePanel with_scene = read_force_panel(write_csv(dir / "b", "forces.csv", csv));
+  ASSERT_EQ(with_scene.rows.size(), 4u);
+  EXPECT_EQ(with_scene.rows[1].key, "depth");
+  EXPECT_EQ(with_scene.rows[1].y_label, "depth below start (mm)");
+  EXPECT_TRUE(with_scene.rows[1].movie);
+  ASSERT_EQ(with_scene.rows[1].series.size(), 1u);
+  EXPECT_NEAR(with_scene.rows[1].series[0].y[4], 8.0, 1e-9);  // 2 mm a sample, positive down
+  EXPECT_EQ(with_scene.rows[2].key, "speed");
+  EXPECT_NEAR(with_scene.rows[2].series[0].y[0], 0.2, 1e-12);
+
+  // the same forces.csv before the motion columns: no rows
+  std::string old = "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m\n0,impactor,0.12,0.132,0,5\n0.01,impactor,0.12,0.13,0,5\n";
+  EXPECT_TRUE(read_force_panel(write_csv(dir / "b", "old.csv", old)).rows.empty());
+  // a bad value in a motion column names it
+  try {
+    read_force_panel(write_csv(dir / "a", "bad.csv",
+                               "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m,torque_N_m_per_m,angle_deg,vx_m_s,vy_m_s,omega_rad_s\n"
+                               "0,a,0,0,1,1,nan,0,0,0,0\n"));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("torque_N_m_per_m"), std::string::npos) << e.what();
+  }
   fs::remove_all(dir);
 }

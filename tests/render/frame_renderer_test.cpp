@@ -446,3 +446,71 @@ TEST(FrameRenderer, SmoothDisplayStaysInsideTheMaterialAndRemovesTheStaircase) {
   // row: the mean squared jump drops by about the pixels per cell
   EXPECT_GT(sq_flat, 4.0 * sq_smooth) << "mean squared jump, flat " << sq_flat / pairs << ", smooth " << sq_smooth / pairs;
 }
+
+// A body that turns and sinks: its torque and depth against time in two charts under the force
+// chart, in the colour of its force trace; the depth trace reaches further down as time goes on.
+// Rows only for the inspector (speed, angle) leave the panel as the force chart alone.
+TEST(FrameRenderer, PanelRowsDrawTorqueAndDepthUnderTheForceChart) {
+  FrameStyle style;
+  style.field = "pressure";
+  style.range = {0.0, max_pressure(), false};
+  ForcePanel panel;
+  ForceSeries s, torque, depth;
+  s.label = torque.label = depth.label = "wheel";
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.01 * k;
+    for (ForceSeries* f : {&s, &torque, &depth}) f->t_s.push_back(t);
+    s.x.push_back(1.0 * k), s.y.push_back(20.0 + std::sin(0.3 * k));
+    torque.x.push_back(t), torque.y.push_back(-0.5 * std::sqrt(t));
+    depth.x.push_back(t), depth.y.push_back(12.0 * t);  // mm
+  }
+  panel.series.push_back(s);
+  panel.rows.push_back({"speed", "speed (m/s)", false, {torque}});
+  style.panel = panel;
+  FieldFrame f = test_frame();
+  f.time_s = 0.9;
+  // inspector-only rows: the same image as without them
+  FrameStyle plain = style;
+  plain.panel->rows.clear();
+  FrameRenderer r_plain(plain), r_speed(style);
+  const RgbImage a = r_plain.render(f), b = r_speed.render(f);
+  EXPECT_TRUE(r_speed.layout().panel_rows.empty());
+  EXPECT_EQ(a.rgb, b.rgb) << "rows not drawn in movies must leave the panel as it was";
+
+  style.panel->rows = {{"torque", "torque (N m/m)", true, {torque}}, {"depth", "depth below start (mm)", true, {depth}},
+                       {"angle", "angle (deg)", false, {torque}}};
+  FrameRenderer r(style);
+  const FrameLayout& L = r.layout();
+  // rows of blue (the first trace's colour) pixels inside one row chart: count, top and bottom
+  struct Extent { int n = 0, top = 1 << 30, bottom = -1; };
+  auto blue = [&](const RgbImage& img, const std::array<int, 4>& box) {
+    Extent e;
+    for (int y = box[1]; y < box[3]; ++y)
+      for (int x = box[0]; x < box[2]; ++x) {
+        const uint8_t* p = img.at(x, y);
+        if (std::abs(p[0] - 31) < 40 && std::abs(p[1] - 92) < 40 && std::abs(p[2] - 180) < 40 && p[2] > p[0] + 80)
+          ++e.n, e.top = std::min(e.top, y), e.bottom = std::max(e.bottom, y);
+      }
+    return e;
+  };
+  f.time_s = 0.2;
+  const RgbImage early = r.render(f);
+  f.time_s = 0.9;
+  const RgbImage late = r.render(f);
+  dump(late, "panel_rows");
+  ASSERT_EQ(L.panel_rows.size(), 2u);
+  for (const auto& box : L.panel_rows) {
+    EXPECT_GE(box[0], L.panel_x0);
+    EXPECT_LE(box[2], L.panel_x1);
+    EXPECT_GT(box[3] - box[1], late.height / 6);
+  }
+  EXPECT_LT(L.panel_rows[0][3], L.panel_rows[1][1] + 2) << "torque above depth";
+  const Extent tq = blue(late, L.panel_rows[0]), d_early = blue(early, L.panel_rows[1]), d_late = blue(late, L.panel_rows[1]);
+  EXPECT_GT(tq.n, 50);
+  EXPECT_GT(d_early.n, 30);
+  EXPECT_GT(d_late.n, d_early.n + 50) << "the depth trace must extend as time advances";
+  // depth grows downwards on the chart's upward axis: the late trace spans more rows of pixels
+  EXPECT_GT(d_late.bottom - d_late.top, (d_early.bottom - d_early.top) + 20);
+  // the force chart above still draws its trace
+  EXPECT_GT(blue(late, {L.panel_x0, 0, L.panel_x1, L.panel_rows[0][1]}).n, 50);
+}
