@@ -128,25 +128,21 @@ ForcePanel read_force_panel(const std::string& path) {
     if (cells.size() != header.size())
       throw std::runtime_error(path + ":" + std::to_string(line_no) + ": " + std::to_string(cells.size()) +
                                " values, header has " + std::to_string(header.size()));
-    double v[6] = {0, 0, 0, 0, 0, 0};
-    for (int k = 0; k < 6; ++k) {
-      if (k == 1) continue;
-      const std::string& s = cells[size_t(col[k])];
+    // a cell of a number column, or an error naming the file, line and column
+    const auto number = [&](int column, const std::string& name) {
+      const std::string& c = cells[size_t(column)];
       char* end = nullptr;
-      v[k] = std::strtod(s.c_str(), &end);
-      if (s.empty() || *end != '\0' || !std::isfinite(v[k]))
-        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column '" + wanted[k] +
-                                 "' must be a finite number, got '" + s + "'");
-    }
-    double m[5] = {0, 0, 0, 0, 0};
-    for (int k = 0; k < 5 && has_motion; ++k) {
-      const std::string& c = cells[size_t(mcol[k])];
-      char* end = nullptr;
-      m[k] = std::strtod(c.c_str(), &end);
-      if (c.empty() || *end != '\0' || !std::isfinite(m[k]))
-        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column '" + motion_names[k] +
+      const double x = std::strtod(c.c_str(), &end);
+      if (c.empty() || *end != '\0' || !std::isfinite(x))
+        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column '" + name +
                                  "' must be a finite number, got '" + c + "'");
-    }
+      return x;
+    };
+    double v[6] = {0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 6; ++k)
+      if (k != 1) v[k] = number(col[k], wanted[k]);
+    double m[5] = {0, 0, 0, 0, 0};
+    for (int k = 0; k < 5 && has_motion; ++k) m[k] = number(mcol[k], motion_names[k]);
     const std::string& name = cells[size_t(col[1])];
     if (!bodies.count(name)) order.push_back(name);
     bodies[name].push_back({v[0], v[2], v[3], v[4], v[5], m[0], m[1], m[2], m[3], m[4]});

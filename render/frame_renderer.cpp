@@ -262,6 +262,18 @@ vtkSmartPointer<vtkTable> make_xy_table(const std::string& x_name, const std::st
   return t;
 }
 
+// The "now" dot on a chart's trace, in the trace's colour
+void add_now_marker(vtkChartXY* chart, vtkTable* mark_t, const std::array<unsigned char, 3>& c, double font_scale) {
+  vtkPlot* mark = chart->AddPlot(vtkChart::POINTS);
+  mark->SetInputData(mark_t, 0, 1);
+  mark->SetColor(c[0], c[1], c[2], 255);
+  mark->SetLegendVisibility(false);
+  if (auto* pts = vtkPlotPoints::SafeDownCast(mark)) {
+    pts->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+    pts->SetMarkerSize(float(std::max(6.0, 12.0 * font_scale)));
+  }
+}
+
 void set_xy_rows(vtkTable* t, const std::vector<double>& x, const std::vector<double>& y) {
   auto* cx = vtkFloatArray::SafeDownCast(t->GetColumn(0));
   auto* cy = vtkFloatArray::SafeDownCast(t->GetColumn(1));
@@ -536,14 +548,7 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
       p.line_tables.push_back(line_t);
       p.marker_tables.push_back(mark_t);
       if (ser.faint) continue;  // the marker sits on the series drawn over it
-      vtkPlot* mark = p.chart->AddPlot(vtkChart::POINTS);
-      mark->SetInputData(mark_t, 0, 1);
-      mark->SetColor(c[0], c[1], c[2], 255);
-      mark->SetLegendVisibility(false);
-      if (auto* pts = vtkPlotPoints::SafeDownCast(mark)) {
-        pts->SetMarkerStyle(vtkPlotPoints::CIRCLE);
-        pts->SetMarkerSize(float(std::max(6.0, 12.0 * font_scale)));
-      }
+      add_now_marker(p.chart, mark_t, c, font_scale);
     }
     vtkAxis* ax = p.chart->GetAxis(vtkAxis::BOTTOM);
     vtkAxis* ay = p.chart->GetAxis(vtkAxis::LEFT);
@@ -588,14 +593,7 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
         line->SetInputData(line_t, 0, 1);
         line->SetColor(c[0], c[1], c[2], 255);
         line->SetWidth(float(std::max(1.5, 2.5 * font_scale)));
-        vtkPlot* mark = chart->AddPlot(vtkChart::POINTS);
-        mark->SetInputData(mark_t, 0, 1);
-        mark->SetColor(c[0], c[1], c[2], 255);
-        mark->SetLegendVisibility(false);
-        if (auto* pts = vtkPlotPoints::SafeDownCast(mark)) {
-          pts->SetMarkerStyle(vtkPlotPoints::CIRCLE);
-          pts->SetMarkerSize(float(std::max(6.0, 12.0 * font_scale)));
-        }
+        add_now_marker(chart, mark_t, c, font_scale);
         p.row_plots.push_back({rows[k], s, line_t, mark_t});
       }
       const ForceAxes a = force_axes(row.series.data(), row.series.size());
