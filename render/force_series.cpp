@@ -39,6 +39,7 @@ struct Sample {
 // What scene.json beside forces.csv says of a body's degrees of freedom.
 struct BodyDofs {
   bool known = false, turns = false, free_x = false, free_y = false;
+  double reach_m = 0.0;  // the farthest the shape's box reaches from the body's origin
 };
 
 std::map<std::string, BodyDofs> scene_dofs(const std::string& forces_path) {
@@ -46,8 +47,11 @@ std::map<std::string, BodyDofs> scene_dofs(const std::string& forces_path) {
   const fs::path scene = fs::path(forces_path).parent_path() / "scene.json";
   if (!fs::exists(scene)) return out;
   try {
-    for (const Body& b : load_scene(scene.string()).bodies)
-      out[b.name] = {true, b.rotates(), b.dynamics.free_x, b.dynamics.free_y};
+    for (const Body& b : load_scene(scene.string()).bodies) {
+      const auto [lo, hi] = shape_bounds_m(b.shape);
+      out[b.name] = {true, b.rotates(), b.dynamics.free_x, b.dynamics.free_y,
+                     std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff())};
+    }
   } catch (const std::exception&) {
     // an unreadable scene.json: the rows follow the data alone
   }
@@ -73,6 +77,8 @@ std::vector<MotionRow> motion_rows(const std::vector<std::string>& order,
     if (!d.turns && !d.free_x && !d.free_y) continue;
     ForceSeries tq, dp, sp, an;
     tq.label = dp.label = sp.label = an.label = name;
+    // a torque under 1% of the largest force times the body's reach is round-off or nearly so
+    for (const Sample& q : s) torque.y_floor = std::max(torque.y_floor, 0.01 * std::hypot(q.fx, q.fy) * d.reach_m);
     for (const Sample& q : s) {
       for (ForceSeries* f : {&tq, &dp, &sp, &an}) f->t_s.push_back(q.t), f->x.push_back(q.t);
       tq.y.push_back(q.torque);

@@ -596,7 +596,7 @@ FrameRenderer::FrameRenderer(const FrameStyle& style) : style_(style) {
         add_now_marker(chart, mark_t, c, font_scale);
         p.row_plots.push_back({rows[k], s, line_t, mark_t});
       }
-      const ForceAxes a = force_axes(row.series.data(), row.series.size());
+      const ForceAxes a = motion_row_axes(row, row.series.data(), row.series.size());
       vtkAxis* bx = chart->GetAxis(vtkAxis::BOTTOM);
       vtkAxis* by = chart->GetAxis(vtkAxis::LEFT);
       bx->SetTitle("time (s)");
@@ -662,6 +662,16 @@ ForceAxes force_axes(const ForceSeries* series, size_t count) {
   const double pad = 0.05 * (top - bottom);
   a.y_lo = bottom < 0 ? bottom - pad : bottom;
   a.y_hi = top + pad;
+  return a;
+}
+
+ForceAxes motion_row_axes(const MotionRow& row, const ForceSeries* series, size_t count) {
+  ForceAxes a = force_axes(series, count);
+  double largest = 0.0;
+  for (const ForceSeries* ser = series; ser != series + count; ++ser)
+    for (double y : ser->y)
+      if (std::isfinite(y)) largest = std::max(largest, std::abs(y));
+  if (row.y_floor > 0.0 && largest <= row.y_floor) a.y_lo = -row.y_floor, a.y_hi = row.y_floor;
   return a;
 }
 

@@ -75,6 +75,9 @@ struct MotionRow {
   std::string y_label;  // with its unit, e.g. "torque (N m/m)"
   bool movie = false;   // drawn as a row under the force chart; the rest only in the inspector
   std::vector<ForceSeries> series;  // labels are body names, as in the force chart
+  // values that all stay within +-y_floor are drawn over +-y_floor: a symmetric body's torque of
+  // round-off size (1e-8 N m/m) then reads as zero rather than as signal at full scale
+  double y_floor = 0.0;
 };
 
 struct ForcePanel {
@@ -99,6 +102,8 @@ struct ForceAxes {
 };
 ForceAxes force_panel_axes(const ForcePanel& panel);
 ForceAxes force_axes(const ForceSeries* series, size_t count);  // the same over `count` series
+// a motion row's axes over `count` of its series: force_axes, widened to the row's y_floor
+ForceAxes motion_row_axes(const MotionRow& row, const ForceSeries* series, size_t count);
 
 struct FrameStyle {
   int width = 1280, height = 720;  // even sizes for movies

@@ -520,7 +520,7 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
       }
       for (const ForceSeries& ser : row->series) {
         if (ser.x.size() < 2) continue;
-        const ForceAxes axes = force_axes(&ser, 1);
+        const ForceAxes axes = motion_row_axes(*row, &ser, 1);
         const std::vector<float> ys = resample(ser, 120, axes.x_lo, axes.x_hi);
         ImGui::Text("%s: %s", ser.label.c_str(), row->y_label.c_str());
         ImGui::PushID(&ser);

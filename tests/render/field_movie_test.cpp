@@ -228,6 +228,20 @@ TEST(ForceSeries, TorqueAndDepthRowsForBodiesThatTurnOrAreFree) {
   EXPECT_EQ(with_scene.rows[2].key, "speed");
   EXPECT_NEAR(with_scene.rows[2].series[0].y[0], 0.2, 1e-12);
 
+  // the impactor's torque against its 1% floor (largest |F| 5 N/m x reach 0.01 m x 0.01 = 5e-4 N m/m):
+  // a torque that reaches 0.4 N m/m sets its own axes
+  EXPECT_NEAR(with_scene.rows[0].y_floor, 5e-4, 1e-12);
+  const ForceAxes real = motion_row_axes(with_scene.rows[0], with_scene.rows[0].series.data(), 1);
+  EXPECT_LT(real.y_lo, -0.4);
+  // a symmetric body's round-off torque (+-2e-8 N m/m) is drawn over the floor, so it reads as zero
+  std::string sym = "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m,torque_N_m_per_m,angle_deg,vx_m_s,vy_m_s,omega_rad_s\n";
+  for (int k = 0; k < 5; ++k)
+    sym += std::to_string(0.01 * k) + ",impactor,0.12,0.13,0,5," + (k % 2 ? "2e-8" : "-2e-8") + ",0,0,-0.2,0\n";
+  const ForcePanel round_off = read_force_panel(write_csv(dir / "b", "forces.csv", sym));
+  const ForceAxes flat = motion_row_axes(round_off.rows[0], round_off.rows[0].series.data(), 1);
+  EXPECT_DOUBLE_EQ(flat.y_lo, -5e-4);
+  EXPECT_DOUBLE_EQ(flat.y_hi, 5e-4);
+
   // the same forces.csv before the motion columns: no rows
   std::string old = "t_s,body,x_m,y_m,Fx_N_per_m,Fy_N_per_m\n0,impactor,0.12,0.132,0,5\n0.01,impactor,0.12,0.13,0,5\n";
   EXPECT_TRUE(read_force_panel(write_csv(dir / "b", "old.csv", old)).rows.empty());
