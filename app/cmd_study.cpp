@@ -386,6 +386,7 @@ Command command_study() {
             "  peak_force   initial peak of the drag (N/m; the drag must give 5% after it)\n"
             "  wedge_angle  apex angle of the rigid wedge under a descending plate (deg; needs the velocity\n"
             "               field stored in frames)\n"
+            "  fluctuation  the lead body's drag: RMS about a line in travel over its mean (paper case 3)\n"
             "Before each rung it prints the wall time predicted from the finished rungs (a line in\n"
             "particle-steps through the rungs of the same settings); after each it rewrites in DIR:\n"
             "  study.csv   per rung: the quantity, its difference from the finest rung of the same settings\n"
@@ -404,7 +405,7 @@ Command command_study() {
             "DIR/scenes and its output in DIR/logs. FURROW_SIGTERM_AFTER_RUNGS=N in the environment makes\n"
             "the study send itself SIGTERM as it starts a rung after N have finished (for tests of the stop).",
             {{"--ladder", true, true, "a key path and its rungs: key.path=v1,v2,v3 or key.path=a:b:step", "KEY=VALUES"},
-             {"--quantity", true, false, "drag_mean (default), lift_mean, peak_force or wedge_angle", "Q"},
+             {"--quantity", true, false, "drag_mean (default), lift_mean, peak_force, wedge_angle or fluctuation", "Q"},
              {"--body", true, false, "the body whose force is read (default: the first moving body)", "NAME"},
              {"--jobs", true, false, "rungs at a time (default 1)", "N"},
              {"--out", true, false, "study directory (default out/<scene name>_study); an existing one is resumed",

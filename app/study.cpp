@@ -19,7 +19,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const std::vector<std::pair<Quantity, std::string>> kQuantities = {{Quantity::DragMean, "drag_mean"},
                                                                    {Quantity::LiftMean, "lift_mean"},
                                                                    {Quantity::PeakForce, "peak_force"},
-                                                                   {Quantity::WedgeAngle, "wedge_angle"}};
+                                                                   {Quantity::WedgeAngle, "wedge_angle"},
+                                                                   {Quantity::Fluctuation, "fluctuation"}};
 
 std::string fmt(const char* f, double v) {
   if (!std::isfinite(v)) return "";
@@ -52,7 +53,7 @@ std::string wall_text(double s) {
 Quantity parse_quantity(const std::string& name) {
   for (const auto& [q, n] : kQuantities)
     if (n == name) return q;
-  throw StudyError("--quantity " + name + ": expected one of drag_mean, lift_mean, peak_force, wedge_angle");
+  throw StudyError("--quantity " + name + ": expected one of drag_mean, lift_mean, peak_force, wedge_angle, fluctuation");
 }
 
 std::string quantity_name(Quantity q) {
@@ -61,10 +62,12 @@ std::string quantity_name(Quantity q) {
   return "?";
 }
 
-std::string quantity_unit(Quantity q) { return q == Quantity::WedgeAngle ? "deg" : "N/m"; }
+std::string quantity_unit(Quantity q) {
+  return q == Quantity::WedgeAngle ? "deg" : q == Quantity::Fluctuation ? "of the mean" : "N/m";
+}
 
 std::string quantity_column(Quantity q) {
-  return quantity_name(q) + (q == Quantity::WedgeAngle ? "_deg" : "_N_per_m");
+  return quantity_name(q) + (q == Quantity::WedgeAngle ? "_deg" : q == Quantity::Fluctuation ? "_relative" : "_N_per_m");
 }
 
 std::string quantity_meaning(Quantity q) {
@@ -79,6 +82,9 @@ std::string quantity_meaning(Quantity q) {
     case Quantity::WedgeAngle:
       return "apex angle of the rigid wedge under the plate, median over the frames of the second half of "
              "the travel (run.json analysis.wedge), deg";
+    case Quantity::Fluctuation:
+      return "relative fluctuation of the lead body's drag: RMS about a line in travel over its mean, bins of "
+             "one dx of travel (run.json analysis.drag; paper case 3)";
   }
   return "";
 }
@@ -95,6 +101,8 @@ std::string cannot_produce(const Scene& scene, Quantity q, const std::string& bo
     }
     if (motion_max_speed_m_s(it->motion) <= 0.0) return "--body " + body + ": the body does not move, so it has no drag";
   }
+  if (q == Quantity::Fluctuation && !body.empty() && body != scene.bodies[size_t(lead)].name)
+    return "fluctuation is measured on the lead body " + scene.bodies[size_t(lead)].name + " only";
   if (q == Quantity::WedgeAngle) {
     if (!body.empty() && body != scene.bodies[size_t(lead)].name)
       return "wedge_angle is measured under the lead body " + scene.bodies[size_t(lead)].name + " only";
@@ -111,6 +119,13 @@ double extract(Quantity q, const sweep::RunMetrics& m, const nlohmann::json& run
     if (why) *why = w;
     return kNaN;
   };
+  if (q == Quantity::Fluctuation) {
+    if (!body.empty() && body != run_json.value("/analysis/lead_body"_json_pointer, std::string()))
+      return fail("fluctuation is measured on the lead body only");
+    const auto f = run_json.value("/analysis/drag/relative_fluctuation"_json_pointer, nlohmann::json());
+    if (!f.is_number()) return fail("run.json has no drag fluctuation (no lead body, or too short a travel)");
+    return f.get<double>();
+  }
   if (q == Quantity::WedgeAngle) {
     const auto a = run_json.value("/analysis/wedge/late_median_apex_angle_deg"_json_pointer, nlohmann::json());
     if (!a.is_number()) return fail("no wedge was found in the frames of the second half of the travel");
@@ -260,7 +275,7 @@ double predict_wall_s(const std::vector<Rung>& rungs, const Rung& r, std::string
 // ---- outputs ------------------------------------------------------------------------------------
 
 std::string study_csv(const std::vector<sweep::Vary>& ladders, Quantity q, const std::vector<Rung>& rungs) {
-  const std::string u = q == Quantity::WedgeAngle ? "_deg" : "_N_per_m";
+  const std::string column = quantity_column(q), u = column.substr(column.find('_', quantity_name(q).size()));
   std::string s = "rung";
   for (const auto& l : ladders) s += "," + sweep::csv_quote(l.column);
   s += ",dx_m,status," + quantity_column(q) + ",diff_from_finest" + u + ",extrapolated" + u +

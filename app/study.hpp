@@ -18,12 +18,12 @@ struct StudyError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Quantity { DragMean, LiftMean, PeakForce, WedgeAngle };
+enum class Quantity { DragMean, LiftMean, PeakForce, WedgeAngle, Fluctuation };
 
-// "drag_mean" | "lift_mean" | "peak_force" | "wedge_angle"; throws StudyError naming the choices.
+// "drag_mean" | "lift_mean" | "peak_force" | "wedge_angle" | "fluctuation"; throws StudyError naming the choices.
 Quantity parse_quantity(const std::string& name);
 std::string quantity_name(Quantity q);
-std::string quantity_unit(Quantity q);     // "N/m" or "deg"
+std::string quantity_unit(Quantity q);     // "N/m", "deg" or "of the mean"
 std::string quantity_column(Quantity q);   // e.g. "drag_mean_N_per_m"
 std::string quantity_meaning(Quantity q);  // one sentence for study.md and --help
 

@@ -84,6 +84,24 @@ TEST(StudyAnalysis, ErrorsAreMeasuredFromTheExtrapolationOfTheMostExpensiveSetti
   }
 }
 
+// case 3's quantity: the lead body's relative drag fluctuation as run.json's analysis states it,
+// refused (NaN and a reason) where the run has none or another body is asked for
+TEST(StudyQuantity, FluctuationIsReadFromTheRunsDragAnalysis) {
+  using namespace furrow::study;
+  const Quantity q = parse_quantity("fluctuation");
+  EXPECT_EQ(quantity_column(q), "fluctuation_relative");
+  const furrow::sweep::RunMetrics metrics;
+  nlohmann::json run = {{"analysis", {{"lead_body", "plow"}, {"drag", {{"relative_fluctuation", 0.0342}}}}}};
+  std::string why;
+  EXPECT_DOUBLE_EQ(extract(q, metrics, run, "", &why), 0.0342);
+  EXPECT_DOUBLE_EQ(extract(q, metrics, run, "plow", &why), 0.0342);
+  EXPECT_TRUE(std::isnan(extract(q, metrics, run, "other", &why)));
+  EXPECT_NE(why.find("lead body"), std::string::npos) << why;
+  run["analysis"]["drag"]["relative_fluctuation"] = nullptr;  // too short a travel
+  EXPECT_TRUE(std::isnan(extract(q, metrics, run, "", &why)));
+  EXPECT_NE(why.find("fluctuation"), std::string::npos) << why;
+}
+
 TEST(StudyPrediction, ALineInParticleStepsThroughTheFinishedRungs) {
   std::vector<Rung> rungs(4);
   for (size_t i = 0; i < rungs.size(); ++i) {
