@@ -20,7 +20,8 @@ namespace furrow::cli {
 
 const char* const kEditScriptHelp =
     "One action per line; '#' starts a comment. Lengths in metres; BODY and BED are a name or an index.\n"
-    "  set KEY.PATH VALUE                  as --set KEY.PATH=VALUE (VALUE is JSON, else a string)\n"
+    "  set KEY.PATH VALUE [; KEY VALUE ...]  as --set KEY.PATH=VALUE (VALUE is JSON, else a string); several\n"
+    "                                      keys after ';' are set together, all or none (a free DOF and its mass)\n"
     "  move BODY X Y                       the body's start position (bodies.BODY.start_m)\n"
     "  resize BODY W H                     a box body's full width and height (shape.size_m)\n"
     "  bed BED X0 Y0 X1 Y1                 a bed's lower-left and upper-right corners\n"
@@ -37,6 +38,33 @@ namespace {
 std::string json_pair(const Vec2& v) { return nlohmann::json::array({v.x(), v.y()}).dump(); }
 }  // namespace
 
+std::vector<std::string> split_assignments(const std::string& key, const std::string& text, std::string* error) {
+  std::vector<std::string> parts(1);
+  bool in_string = false;
+  for (size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (c == '"' && (k == 0 || text[k - 1] != '\\')) in_string = !in_string;
+    if (c == ';' && !in_string) parts.emplace_back();
+    else parts.back() += c;
+  }
+  auto trim = [](std::string t) {
+    t.erase(0, t.find_first_not_of(" \t"));
+    t.erase(t.find_last_not_of(" \t\r") + 1);
+    return t;
+  };
+  std::vector<std::string> out = {key + "=" + trim(parts[0])};
+  for (size_t k = 1; k < parts.size(); ++k) {
+    const std::string part = trim(parts[k]);
+    const size_t gap = part.find_first_of(" \t");
+    if (part.empty() || gap == std::string::npos) {
+      *error = "expected 'KEY.PATH VALUE' after ';' (got '" + part + "')";
+      return {};
+    }
+    out.push_back(part.substr(0, gap) + "=" + trim(part.substr(gap)));
+  }
+  return out;
+}
+
 std::optional<EditAction> parse_edit_line(const std::string& line, std::string* error) {
   error->clear();
   const std::vector<std::string> w = render::script_words(line);
@@ -48,10 +76,9 @@ std::optional<EditAction> parse_edit_line(const std::string& line, std::string* 
     if (w.size() < 3) return *error = "expected 'set KEY.PATH VALUE'", std::nullopt;
     const std::string body = line.substr(0, line.find('#'));
     const size_t key_at = body.find(w[1], body.find("set") + 3);
-    std::string value = body.substr(key_at + w[1].size());
-    value.erase(0, value.find_first_not_of(" \t"));
-    value.erase(value.find_last_not_of(" \t\r") + 1);
-    return SetKey{w[1] + "=" + value};
+    std::vector<std::string> all = split_assignments(w[1], body.substr(key_at + w[1].size()), error);
+    if (all.empty()) return std::nullopt;
+    return SetKey{all.front(), std::vector<std::string>(all.begin() + 1, all.end())};
   }
   if (verb == "move" || verb == "resize") {
     const std::string expected = verb == "move" ? "move BODY X Y" : "resize BODY W H";
@@ -183,7 +210,9 @@ nlohmann::json refused(EditorState& s, const std::string& action, const std::str
 nlohmann::json apply_edit(EditorState& s, const EditAction& action, render::SceneView* view) {
   nlohmann::json r;
   if (auto* a = std::get_if<SetKey>(&action)) {
-    r = edit(s, "set", {a->assignment});
+    std::vector<std::string> all = {a->assignment};
+    all.insert(all.end(), a->more.begin(), a->more.end());
+    r = edit(s, "set", all);
   } else if (auto* a = std::get_if<MoveBody>(&action)) {
     r = edit(s, "move", {body_key(a->body) + ".start_m=" + json_pair(a->start_m)});
   } else if (auto* a = std::get_if<ResizeBody>(&action)) {
@@ -320,13 +349,18 @@ nlohmann::json panel_edit(EditorState& s, const render::PanelChanges& e) {
     s.typing_error.clear();
     return nullptr;
   }
-  const std::string assignment = e.key + "=" + e.text;
+  std::string split_error;
+  const std::vector<std::string> all = split_assignments(e.key, e.text, &split_error);
+  if (all.empty()) {
+    s.typing_error = split_error;
+    return nullptr;
+  }
   if (!e.committed) {
-    const Attempt a = attempt(s, {assignment});
+    const Attempt a = attempt(s, all);
     s.typing_error = a.error ? a.error->what() : "";
     return nullptr;
   }
-  nlohmann::json r = apply_edit(s, SetKey{assignment}, nullptr);
+  nlohmann::json r = apply_edit(s, SetKey{all.front(), std::vector<std::string>(all.begin() + 1, all.end())}, nullptr);
   s.typing_error = r["ok"] == true ? "" : r["error"].get<std::string>();
   return r;
 }
@@ -348,6 +382,20 @@ render::ScenePanel editor_panel(const EditorState& s) {
     p.preview_status = "preview starting";
   }
   flatten(scene_to_json(s.scene), "", &p.keys);
+  // the rotation and response keys a body does not use yet (the resolved scene leaves them out),
+  // after the body's own keys, so they can be typed into like the rest; a free DOF needs its mass
+  // in the same edit: ["y"]; bodies.0.mass_kg_per_m 5
+  for (size_t b = 0; b < s.scene.bodies.size(); ++b) {
+    const Body& body = s.scene.bodies[b];
+    const std::string prefix = "bodies." + std::to_string(b) + ".";
+    std::vector<std::pair<std::string, std::string>> absent;
+    if (body.start_angle_rad == 0.0) absent.push_back({prefix + "start_angle_deg", "0"});
+    if (body.motion.kind == Motion::Kind::ConstantVelocity && body.motion.angular_velocity_rad_s == 0.0)
+      absent.push_back({prefix + "motion.angular_velocity_rad_s", "0"});
+    if (!body.dynamics.any_free()) absent.push_back({prefix + "free", "[]"});
+    auto last = std::find_if(p.keys.rbegin(), p.keys.rend(), [&](const auto& kv) { return kv.first.rfind(prefix, 0) == 0; });
+    p.keys.insert(last.base(), absent.begin(), absent.end());
+  }
   return p;
 }
 

@@ -19,7 +19,11 @@
 namespace furrow::cli {
 
 // ---- actions (one per script line) ---------------------------------------------------------------
-struct SetKey { std::string assignment; };  // "key.path=value", as --set
+// "key.path=value", as --set; `more` are applied with it, all or none (a free DOF and its mass)
+struct SetKey {
+  std::string assignment;
+  std::vector<std::string> more;
+};
 struct MoveBody { std::string body; Vec2 start_m{0, 0}; };
 struct ResizeBody { std::string body; Vec2 size_m{0, 0}; };
 struct SetBed { std::string bed; Vec2 min_m{0, 0}, max_m{0, 0}; };
@@ -32,6 +36,11 @@ using EditAction = std::variant<SetKey, MoveBody, ResizeBody, SetBed, Validate, 
 // One script line as an action; on a bad line std::nullopt and *error says what was expected
 // (blank lines and comments: std::nullopt, empty error).
 std::optional<EditAction> parse_edit_line(const std::string& line, std::string* error);
+
+// `set`'s and the panel's value text for `key`: "VALUE" or "VALUE; KEY2 VALUE2; ..." as --set
+// assignments, the first for `key`; ';' inside a JSON string does not split. Empty on a part
+// that is not "KEY VALUE" (*error says which).
+std::vector<std::string> split_assignments(const std::string& key, const std::string& text, std::string* error);
 
 struct EditStep {
   int line = 0;

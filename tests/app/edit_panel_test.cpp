@@ -142,3 +142,44 @@ TEST(EditPanel, ABodyIsDrawnAtItsStartAngle) {
   EXPECT_FALSE(body_px(scene, {0.04, 0.0}));
   EXPECT_TRUE(body_px(scene, {0.0, 0.04}));
 }
+
+// Rotation and response from the panel: a body that neither turns nor responds still lists its
+// start angle, angular velocity and free DOFs (the resolved scene leaves them out); a free DOF
+// typed alone is refused for want of a mass, and typed with its mass after ';' is set, both at once.
+TEST(EditPanel, RotationAndFreeDofsCanBeTypedIn) {
+  EditorState s = furrow::cli::open_scene_for_edit("plate_intrusion");
+  const auto panel = furrow::cli::editor_panel(s);
+  auto value_of = [&](const std::string& key) -> std::string {
+    for (const auto& kv : panel.keys)
+      if (kv.first == key) return kv.second;
+    return "(absent)";
+  };
+  EXPECT_EQ(value_of("bodies.0.start_angle_deg"), "0");
+  EXPECT_EQ(value_of("bodies.0.motion.angular_velocity_rad_s"), "0");
+  EXPECT_EQ(value_of("bodies.0.free"), "[]");
+  SceneView view(1280, 720);
+  view.render(s.scene, panel);
+  ASSERT_TRUE(view.key_row_px("bodies.0.free").has_value());
+
+  PanelChanges alone;
+  alone.key = "bodies.0.free", alone.text = "[\"y\"]", alone.committed = true;
+  const json refused = furrow::cli::panel_edit(s, alone);
+  EXPECT_EQ(refused["ok"], false);
+  EXPECT_NE(refused["error"].get<std::string>().find("mass"), std::string::npos) << refused["error"];
+  EXPECT_FALSE(s.scene.bodies[0].dynamics.free_y);
+
+  PanelChanges with_mass = alone;
+  with_mass.text = "[\"y\"]; bodies.0.mass_kg_per_m 5";
+  const json set = furrow::cli::panel_edit(s, with_mass);
+  ASSERT_EQ(set["ok"], true) << set.dump();
+  EXPECT_TRUE(s.scene.bodies[0].dynamics.free_y);
+  EXPECT_DOUBLE_EQ(s.scene.bodies[0].dynamics.mass_kg_per_m, 5.0);
+  // now from the resolved scene, with its value
+  bool listed = false;
+  for (const auto& kv : furrow::cli::editor_panel(s).keys) listed |= kv.first == "bodies.0.free" && kv.second == "[\"y\"]";
+  EXPECT_TRUE(listed);
+  // a part after ';' that is not KEY VALUE names itself
+  std::string error;
+  EXPECT_TRUE(furrow::cli::split_assignments("k", "1; bodies.0.mass_kg_per_m", &error).empty());
+  EXPECT_NE(error.find("bodies.0.mass_kg_per_m"), std::string::npos) << error;
+}
