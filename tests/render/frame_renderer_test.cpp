@@ -8,7 +8,10 @@
 #include <filesystem>
 
 #include "engine/io/field_store.hpp"
+#include "engine/run.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/colormap.hpp"
+#include "render/force_series.hpp"
 #include "render/frame_renderer.hpp"
 #include "tests/render/capture_output.hpp"
 #include "tests/render/synthetic_frames.hpp"
@@ -513,4 +516,55 @@ TEST(FrameRenderer, PanelRowsDrawTorqueAndDepthUnderTheForceChart) {
   EXPECT_GT(d_late.bottom - d_late.top, (d_early.bottom - d_early.top) + 20);
   // the force chart above still draws its trace
   EXPECT_GT(blue(late, {L.panel_x0, 0, L.panel_x1, L.panel_rows[0][1]}).n, 50);
+}
+
+// The rows from a real run rather than made-up series: the wheel template coarsened to dx 6 mm and
+// 0.15 s (under a second). Its forces.csv and scene.json give torque and depth rows for the movie
+// (the wheel turns and its y is free) and speed and angle for the inspector; the driven wheel's
+// torque (~0.3 N m/m) is signal, far above the row's floor; the wheel sinks; a stored frame drawn
+// with that panel shows both traces in the wheel's colour.
+TEST(FrameRenderer, AWheelRunsPanelDrawsItsTorqueAndDepthRows) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("furrow_wheel_rows_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const Scene scene = parse_scene_text(find_scene_template("wheel")->text, "<template wheel>",
+                                       {"domain.dx_m=0.006", "solver.end_time_s=0.15", "outputs.frame_interval_s=0.05",
+                                        "outputs.force_interval_s=0.005", "outputs.average_window.from_s=0",
+                                        "outputs.average_window.to_s=0.15", "solver.threads=1"});
+  RunOptions options;
+  options.out_dir = dir.string();
+  options.write_paraview = false;
+  run_scene(scene, options);
+
+  const ForcePanel panel = read_force_panel((dir / "forces.csv").string());
+  ASSERT_EQ(panel.rows.size(), 4u);
+  EXPECT_EQ(panel.rows[0].key, "torque");
+  EXPECT_EQ(panel.rows[1].key, "depth");
+  EXPECT_TRUE(panel.rows[0].movie && panel.rows[1].movie);
+  EXPECT_FALSE(panel.rows[2].movie || panel.rows[3].movie);
+  double torque_max = 0.0;
+  for (double t : panel.rows[0].series[0].y) torque_max = std::max(torque_max, std::abs(t));
+  EXPECT_GT(torque_max, 10.0 * panel.rows[0].y_floor);
+  EXPECT_GT(panel.rows[1].series[0].y.back(), 0.5);  // mm below its start
+
+  FrameStyle style;
+  style.field = "pressure";
+  style.range = {0.0, 2000.0, false};
+  style.panel = panel;
+  FieldFrame f = read_frame(frame_path(dir.string(), 3));
+  FrameRenderer r(style);
+  const RgbImage img = r.render(f);
+  dump(img, "wheel_rows");
+  const FrameLayout& L = r.layout();
+  ASSERT_EQ(L.panel_rows.size(), 2u);
+  for (const auto& box : L.panel_rows) {
+    int n = 0;
+    for (int y = box[1]; y < box[3]; ++y)
+      for (int x = box[0]; x < box[2]; ++x) {
+        const uint8_t* p = img.at(x, y);
+        n += std::abs(p[0] - 31) < 40 && std::abs(p[1] - 92) < 40 && std::abs(p[2] - 180) < 40 && p[2] > p[0] + 80;
+      }
+    EXPECT_GT(n, 30) << "row " << box[1];
+  }
+  fs::remove_all(dir);
 }
