@@ -389,8 +389,10 @@ void Simulation::respond_free_body(size_t b, Vec2& impulse, double& angular) {
   A(0, 0) += d.mass_kg_per_m;
   A(1, 1) += d.mass_kg_per_m;
   A(2, 2) += d.inertia_kg_m;
-  const Vec2 load = d.applied_force_N_per_m + d.mass_kg_per_m * gravity_;
-  const Vec3 rhs(dt * load.x() - impulse.x(), dt * load.y() - impulse.y(), dt * d.applied_torque_N - angular);
+  // the applied load at the step's end time, ramped (a footing set down gently); the weight at once
+  const double ramp = d.load_ramp_s > 0.0 ? std::min(1.0, (t_s_ + dt) / d.load_ramp_s) : 1.0;
+  const Vec2 load = ramp * d.applied_force_N_per_m + d.mass_kg_per_m * gravity_;
+  const Vec3 rhs(dt * load.x() - impulse.x(), dt * load.y() - impulse.y(), dt * ramp * d.applied_torque_N - angular);
   // the free degrees of freedom only: a prescribed one does not change here
   const bool free[3] = {d.free_x, d.free_y, d.free_angle};
   int index[3], nf = 0;

@@ -81,6 +81,7 @@ struct BodyDynamics {
   double inertia_kg_m = 0.0;     // moment of inertia about the origin, kg m^2 per metre
   Vec2 applied_force_N_per_m{0.0, 0.0};  // a constant load (a wheel's weight on its axle)
   double applied_torque_N = 0.0;         // N m per metre: a motor's torque, counter-clockwise
+  double load_ramp_s = 0.0;  // the applied force and torque rise linearly from 0 over this time (0: at once)
   bool any_free() const { return free_x || free_y || free_angle; }
 };
 

@@ -437,10 +437,11 @@ BodyDynamics read_dynamics(Obj& o, const Shape& shape) {
   const json* inertia = o.opt("inertia_kg_m");
   const json* force = o.opt("applied_force_N_per_m");
   const json* torque = o.opt("applied_torque_N");
+  const json* ramp = o.opt("load_ramp_s");
   if (!d.any_free()) {
     // a prescribed body has no use for them: say so rather than ignore them
     for (const auto& [key, v] : {std::pair{"mass_kg_per_m", mass}, {"density_kg_m3", density}, {"inertia_kg_m", inertia},
-                                 {"applied_force_N_per_m", force}, {"applied_torque_N", torque}})
+                                 {"applied_force_N_per_m", force}, {"applied_torque_N", torque}, {"load_ramp_s", ramp}})
       if (v) fail(c, o.at(key), *v, "no \"" + std::string(key) + "\" on a body whose motion is all prescribed (list the degrees of freedom that respond in \"free\")");
     return d;
   }
@@ -460,6 +461,7 @@ BodyDynamics read_dynamics(Obj& o, const Shape& shape) {
   }
   if (force) d.applied_force_N_per_m = as_vec2(c, *force, o.at("applied_force_N_per_m"), kAny, "N per metre");
   if (torque) d.applied_torque_N = as_number(c, *torque, o.at("applied_torque_N"), kAny, "N m per metre, counter-clockwise");
+  if (ramp) d.load_ramp_s = as_number(c, *ramp, o.at("load_ramp_s"), kNonNegative, "seconds over which the applied load rises from 0");
   return d;
 }
 

@@ -105,7 +105,7 @@ const KeyList kMaterialDpmKeys = {"name", "model", "grain_density_kg_m3", "phi_c
                                   "phi_min", "youngs_modulus_Pa", "poisson_ratio", "mu_2", "I0", "grain_diameter_m"};
 const KeyList kBedKeys = {"material", "min_m", "max_m", "packing_fraction", "k0", "geostatic"};
 const KeyList kBodyKeys = {"name", "shape", "start_m", "start_angle_deg", "motion", "free", "mass_kg_per_m", "density_kg_m3",
-                           "inertia_kg_m", "applied_force_N_per_m", "applied_torque_N", "friction"};
+                           "inertia_kg_m", "applied_force_N_per_m", "applied_torque_N", "load_ramp_s", "friction"};
 const KeyList kBoxKeys = {"type", "size_m"};
 const KeyList kCircleKeys = {"type", "radius_m"};
 const KeyList kPolygonKeys = {"type", "vertices_m"};

@@ -133,6 +133,7 @@ J to_json(const Scene& s) {
       bj["inertia_kg_m"] = d.inertia_kg_m;
       bj["applied_force_N_per_m"] = vec_json<J>(d.applied_force_N_per_m);
       bj["applied_torque_N"] = d.applied_torque_N;
+      if (d.load_ramp_s > 0.0) bj["load_ramp_s"] = d.load_ramp_s;
     }
     bj["friction"] = b.friction;
     j["bodies"].push_back(bj);

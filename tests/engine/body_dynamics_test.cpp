@@ -69,6 +69,34 @@ TEST(BodyDynamics, FreeBodyFarFromTheMediaFallsAtG) {
   EXPECT_NEAR(body.force_N_per_m.norm(), 0.0, 1e-12);
 }
 
+// An applied load ramped over load_ramp_s, in the air and without gravity: the velocity grows as
+// F t^2 / (2 m T) until T, then by F / m per second (symplectic Euler with the load at each step's
+// end time: within F dt / m of that); the torque ramps alike.
+TEST(BodyDynamics, RampedLoadRisesLinearlyOverItsRampTime) {
+  Scene s = test_scenes::bed_scene(0.2, 0.02, 0.5, 0.005, 0.08);
+  s.effects.gravity = false;
+  Body b = disk(0.01, Vec2(0.1, 0.4), Vec2(0.0, 0.0));
+  make_free(b, true, true, true, 7800.0);
+  b.dynamics.applied_force_N_per_m = Vec2(3.0, 0.0);
+  b.dynamics.applied_torque_N = 0.02;
+  b.dynamics.load_ramp_s = 0.05;
+  s.bodies.push_back(b);
+  Simulation sim(s);
+  const double m = b.dynamics.mass_kg_per_m, I = b.dynamics.inertia_kg_m, T = 0.05;
+  bool checked_during = false;
+  while (!sim.finished()) {
+    sim.step();
+    const double t = sim.time_s(), dt = sim.last_dt_s();
+    const double ramp_part = std::min(t, T), v = 3.0 / m * (ramp_part * ramp_part / (2.0 * T) + std::max(0.0, t - T));
+    const double w = 0.02 / I * (ramp_part * ramp_part / (2.0 * T) + std::max(0.0, t - T));
+    ASSERT_NEAR(sim.bodies()[0].velocity_m_s.x(), v, 3.0 / m * dt) << "t " << t;
+    ASSERT_NEAR(sim.bodies()[0].omega_rad_s, w, 0.02 / I * dt) << "t " << t;
+    checked_during |= t > 0.02 && t < 0.04;
+  }
+  EXPECT_TRUE(checked_during);
+  EXPECT_EQ(sim.bodies()[0].velocity_m_s.y(), 0.0);
+}
+
 // A free disk spinning in the air keeps its angular velocity, and its angle grows as omega t.
 TEST(BodyDynamics, FreeDiskSpinningInTheAirKeepsItsAngularVelocity) {
   Scene s = test_scenes::bed_scene(0.2, 0.02, 0.5, 0.005, 0.05);

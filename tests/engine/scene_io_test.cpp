@@ -344,6 +344,8 @@ std::vector<BadCase> bad_cases() {
       {"mixed averaging window", with(P, [](json& j) { j["outputs"]["average_window"]["from_s"] = 0.1; }), {}, "/outputs/average_window", "either"},
       {"end displacement without a moving body", plain("hydrostatic_bed"), {"solver.end_displacement_m=0.1"}, "/solver/end_displacement_m", "no body moves"},
       {"scene name with a slash", plain(P), {"name=\"a/b\""}, "/name", "name"},
+      {"negative load ramp", plain("footing"), {"bodies.footing.load_ramp_s=-0.1"}, "/bodies/0/load_ramp_s", "seconds"},
+      {"load ramp on a prescribed body", plain(P), {"bodies.plate.load_ramp_s=0.1"}, "/bodies/0/load_ramp_s", "prescribed"},
   };
 }
 
