@@ -344,7 +344,7 @@ int render_main(const Parsed& p) {
           mine->series.push_back(s);
         }
       }
-      const std::vector<std::string> order = {"torque", "depth", "speed", "angle"};
+      const std::vector<std::string>& order = render::motion_row_keys();
       std::stable_sort(panel.rows.begin(), panel.rows.end(), [&](const auto& a, const auto& b) {
         return std::find(order.begin(), order.end(), a.key) < std::find(order.begin(), order.end(), b.key);
       });

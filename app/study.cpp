@@ -66,9 +66,12 @@ std::string quantity_unit(Quantity q) {
   return q == Quantity::WedgeAngle ? "deg" : q == Quantity::Fluctuation ? "of the mean" : "N/m";
 }
 
-std::string quantity_column(Quantity q) {
-  return quantity_name(q) + (q == Quantity::WedgeAngle ? "_deg" : q == Quantity::Fluctuation ? "_relative" : "_N_per_m");
+// the unit part of the quantity's columns in study.csv
+static std::string column_suffix(Quantity q) {
+  return q == Quantity::WedgeAngle ? "_deg" : q == Quantity::Fluctuation ? "_relative" : "_N_per_m";
 }
+
+std::string quantity_column(Quantity q) { return quantity_name(q) + column_suffix(q); }
 
 std::string quantity_meaning(Quantity q) {
   switch (q) {
@@ -275,7 +278,7 @@ double predict_wall_s(const std::vector<Rung>& rungs, const Rung& r, std::string
 // ---- outputs ------------------------------------------------------------------------------------
 
 std::string study_csv(const std::vector<sweep::Vary>& ladders, Quantity q, const std::vector<Rung>& rungs) {
-  const std::string column = quantity_column(q), u = column.substr(column.find('_', quantity_name(q).size()));
+  const std::string u = column_suffix(q);
   std::string s = "rung";
   for (const auto& l : ladders) s += "," + sweep::csv_quote(l.column);
   s += ",dx_m,status," + quantity_column(q) + ",diff_from_finest" + u + ",extrapolated" + u +

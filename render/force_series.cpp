@@ -91,7 +91,7 @@ std::vector<MotionRow> motion_rows(const std::vector<std::string>& order,
     if (d.free_x || d.free_y) speed.series.push_back(std::move(sp));
     angle.series.push_back(std::move(an));
   }
-  std::vector<MotionRow> rows;
+  std::vector<MotionRow> rows;  // in motion_row_keys()' order
   for (MotionRow* r : {&torque, &depth, &speed, &angle})
     if (!r->series.empty()) rows.push_back(std::move(*r));
   return rows;

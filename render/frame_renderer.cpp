@@ -298,10 +298,9 @@ void series_until(const ForceSeries& s, double time, std::vector<double>& x, std
   }
   if (k <= 1 && n > 0) {
     x.push_back(x.back()), y.push_back(y.back());  // a line needs two points, even at the start
-  } else if (k < n && s.t_s[k] > s.t_s[k - 1]) {
-    const double w = (time - s.t_s[k - 1]) / (s.t_s[k] - s.t_s[k - 1]);
-    x.push_back(s.x[k - 1] + w * (s.x[k] - s.x[k - 1]));
-    y.push_back(s.y[k - 1] + w * (s.y[k] - s.y[k - 1]));
+  } else if (k < n) {
+    x.push_back(value_at_time(s, s.x, time));
+    y.push_back(value_at_time(s, s.y, time));
   }
 }
 
@@ -663,6 +662,22 @@ ForceAxes force_axes(const ForceSeries* series, size_t count) {
   a.y_lo = bottom < 0 ? bottom - pad : bottom;
   a.y_hi = top + pad;
   return a;
+}
+
+const std::vector<std::string>& motion_row_keys() {
+  static const std::vector<std::string> keys = {"torque", "depth", "speed", "angle"};
+  return keys;
+}
+
+double value_at_time(const ForceSeries& s, const std::vector<double>& values, double t_s) {
+  const size_t n = std::min(s.t_s.size(), values.size());
+  if (n == 0) return std::numeric_limits<double>::quiet_NaN();
+  size_t k = 0;
+  while (k < n && s.t_s[k] <= t_s) ++k;
+  if (k == 0) return values[0];
+  if (k == n) return values[n - 1];
+  const double w = (t_s - s.t_s[k - 1]) / (s.t_s[k] - s.t_s[k - 1]);  // t_s[k] > t_s >= t_s[k - 1]
+  return values[k - 1] + w * (values[k] - values[k - 1]);
 }
 
 ForceAxes motion_row_axes(const MotionRow& row, const ForceSeries* series, size_t count) {

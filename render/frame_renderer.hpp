@@ -104,6 +104,11 @@ ForceAxes force_panel_axes(const ForcePanel& panel);
 ForceAxes force_axes(const ForceSeries* series, size_t count);  // the same over `count` series
 // a motion row's axes over `count` of its series: force_axes, widened to the row's y_floor
 ForceAxes motion_row_axes(const MotionRow& row, const ForceSeries* series, size_t count);
+// The motion rows' keys in the order a panel lists them.
+const std::vector<std::string>& motion_row_keys();
+// `values` (a series' x or y) at time t_s, linear between the samples around it, the end values
+// outside them; NaN for an empty series.
+double value_at_time(const ForceSeries& s, const std::vector<double>& values, double t_s);
 
 struct FrameStyle {
   int width = 1280, height = 720;  // even sizes for movies

@@ -320,16 +320,6 @@ size_t nearest_time(const InspectorState& s, double t) {
   return best;
 }
 
-// Linear interpolation of a series' y at time t (its ends outside them).
-double y_at_time(const ForceSeries& s, double t) {
-  if (s.t_s.empty()) return NAN;
-  if (t <= s.t_s.front()) return s.y.front();
-  for (size_t k = 1; k < s.t_s.size(); ++k)
-    if (t <= s.t_s[k])
-      return s.y[k - 1] + (s.y[k] - s.y[k - 1]) * (t - s.t_s[k - 1]) / std::max(1e-300, s.t_s[k] - s.t_s[k - 1]);
-  return s.y.back();
-}
-
 std::string short_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -367,7 +357,7 @@ nlohmann::json apply_action(InspectorState& s, const InspectAction& action, Insp
     s.motion = a->key;
     // each body's value at the current frame's time
     nlohmann::json values = nlohmann::json::object();
-    for (const ForceSeries& ser : row->series) values[ser.label] = y_at_time(ser, s.frame.time_s);
+    for (const ForceSeries& ser : row->series) values[ser.label] = value_at_time(ser, ser.y, s.frame.time_s);
     r = {{"action", "plot"}, {"quantity", a->key}, {"label", row->y_label}, {"values", values}};
     r.update(where(s));
     s.notes.push_back("plot " + row->y_label);
@@ -532,7 +522,7 @@ std::vector<InspectAction> draw_inspector_panel(const InspectorState& s, float x
         const double u = (axes.x_hi > axes.x_lo) ? (s.frame.time_s - axes.x_lo) / (axes.x_hi - axes.x_lo) : 0.0;
         const float px = r0.x + pad.x + float(std::clamp(u, 0.0, 1.0)) * (r1.x - r0.x - 2 * pad.x);
         ImGui::GetWindowDrawList()->AddLine(ImVec2(px, r0.y), ImVec2(px, r1.y), IM_COL32(255, 200, 0, 255), 2.0f);
-        ImGui::Text("time (s): %.4g .. %.4g   now %.4g", axes.x_lo, axes.x_hi, y_at_time(ser, s.frame.time_s));
+        ImGui::Text("time (s): %.4g .. %.4g   now %.4g", axes.x_lo, axes.x_hi, value_at_time(ser, ser.y, s.frame.time_s));
       }
       ImGui::Separator();
     }
