@@ -40,10 +40,15 @@ std::string scene_summary(const Scene& s, const std::string& source) {
        << ", wave speed " << fmt("%.3g", wave_speed_m_s(m)) << " m/s\n";
   for (const auto& b : s.bodies) {
     const double cells = body_cells_across(s, b), bias = contact_size_bias(s.solver.contact, cells);
+    const double omega = motion_max_angular_speed_rad_s(b.motion);
     os << "  body       " << b.name << ": " << kShapeNames[int(b.shape.kind)] << ", " << fmt("%.3g", cells)
-       << " cells across its travel, max speed " << fmt("%g", motion_max_speed_m_s(b.motion)) << " m/s, "
-       << contact_method_name(s.solver.contact) << " contact";
-    if (cells < 8.0)
+       << " cells across its travel, max speed " << fmt("%g", motion_max_speed_m_s(b.motion)) << " m/s";
+    if (omega > 0.0) os << ", turning at up to " << fmt("%g", omega) << " rad/s";
+    os << ", " << contact_method_name(s.solver.contact) << " contact";
+    // a body that turns has no side inset to its field (engine/README.md): the plate bias is not its
+    if (omega > 0.0 || b.dynamics.free_angle)
+      os << " (it turns: its field acts up to a cell beyond its surface)";
+    else if (cells < 8.0)
       os << " (under 8 cells across: its force depends strongly on dx and the contact method)";
     else if (std::abs(bias) >= 0.01)
       os << " (a plate this many cells across reads ~" << fmt("%.0f", 100 * std::abs(bias)) << "% "

@@ -1,8 +1,9 @@
 // Bodies that turn and bodies that respond to the media (two-way coupling): the rigid-body
 // mechanics on their own, momentum exchanged with the media to round-off, torque from friction
-// only, and the impactor, wheel and footing templates' claims at a coarse dx.
+// only, and the impactor, wheel, footing and leg templates' claims at a coarse dx.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -243,6 +244,61 @@ TEST(BodyDynamics, WheelDrawbarPullAndSinkageRiseWithSlip) {
     if (slip < 0) first_sinkage = sinkage;
     last_pull = pull, last_sinkage = sinkage, last_torque = torque;
   }
+}
+
+// leg: a C-leg turning about its hip while the hip moves +x. Swept backwards through the bed
+// (clockwise, the foot moving -x at the bottom) it pushes the grains back and is pushed forward:
+// thrust, largest with the leg near hanging straight down (deepest, moving across); its mirror
+// image swept forwards is dragged back. Either way the media resist the sweep at every instant (torque against
+// omega), lift the leg while the foot goes down and hold it back while it comes up. dx 5 mm.
+TEST(BodyDynamics, LegSweptBackThroughTheBedIsPushedForwardAndTheMediaResistItsTurn) {
+  double mean_thrust[2] = {0.0, 0.0};
+  for (int sweep = 0; sweep < 2; ++sweep) {
+    Scene s = template_scene("leg");
+    s.domain.dx_m = 0.005;
+    s.outputs.fields.clear();
+    Body& leg = s.bodies[0];
+    if (sweep == 1) {  // the mirror image of the leg and its turn; the hip still moves +x
+      leg.motion.angular_velocity_rad_s = -leg.motion.angular_velocity_rad_s;
+      leg.start_angle_rad = -leg.start_angle_rad;
+      for (Shape& part : leg.shape.parts) {
+        for (Vec2& v : part.vertices_m) v.x() = -v.x();
+        std::reverse(part.vertices_m.begin(), part.vertices_m.end());  // counter-clockwise again
+        part.offset_m.x() = -part.offset_m.x();
+      }
+    }
+    const double omega = leg.motion.angular_velocity_rad_s;
+    Simulation sim(s);
+    double fx = 0.0, span = 0.0, fy_down = 0.0, span_down = 0.0, fy_up = 0.0, span_up = 0.0;
+    double peak_fx = 0.0, peak_angle = 0.0;
+    int against = 0, with = 0;
+    while (!sim.finished()) {
+      sim.step();
+      const BodyState& b = sim.bodies()[0];
+      const double dt = sim.last_dt_s(), angle = b.angle_rad;
+      if (b.force_N_per_m.norm() < 1.0) continue;  // out of the bed
+      fx += b.force_N_per_m.x() * dt, span += dt;
+      // the foot goes down while the leg points ahead of its sweep, up once past hanging
+      const double ahead = omega < 0 ? angle : -angle;
+      if (ahead > M_PI / 6) fy_down += b.force_N_per_m.y() * dt, span_down += dt;
+      if (ahead < -M_PI / 6) fy_up += b.force_N_per_m.y() * dt, span_up += dt;
+      if (std::abs(b.force_N_per_m.x()) > std::abs(peak_fx)) peak_fx = b.force_N_per_m.x(), peak_angle = angle;
+      ++(b.torque_N * omega < 0.0 ? against : with);
+    }
+    ASSERT_GT(span, 0.2) << "the leg never reached the bed";
+    mean_thrust[sweep] = fx / span;
+    std::printf("%s sweep: mean Fx %.2f N/m in the bed (%.3f s), peak %.2f N/m at %.1f deg; mean Fy %.2f N/m "
+                "foot going down, %.2f coming up; torque against the turn in %d of %d steps\n",
+                omega < 0 ? "backward" : "forward", mean_thrust[sweep], span, peak_fx, peak_angle * 180 / M_PI,
+                fy_down / span_down, fy_up / span_up, against, against + with);
+    EXPECT_EQ(with, 0);
+    EXPECT_GT(fy_down / span_down, 0.0);
+    EXPECT_LT(fy_up / span_up, 0.0);
+    if (sweep == 0) EXPECT_LT(std::abs(peak_angle), M_PI / 6);
+  }
+  // measured 23.7 and -42.6 N/m
+  EXPECT_GT(mean_thrust[0], 0.0);
+  EXPECT_LT(mean_thrust[1], 0.0);
 }
 
 // A plate held at an angle is the same body as the untilted one to the contact: tilted by a
