@@ -19,7 +19,10 @@ constexpr char kCheckpointMagic[8] = {'F', 'U', 'R', 'R', 'O', 'W', 'C', 'K'};
 // column-major node order; version 1 (row-major) is still read and renumbered.
 // 3: P2G's strip ranges (the points' home strips). Versions 1 and 2 are read and the points sorted
 // into strips again before the next step.
-constexpr uint32_t kCheckpointVersion = 4;  // 4: bodies carry an angle, angular velocity and torque
+// 4: bodies carry an angle, angular velocity and torque.
+// 5: where each strip's rows start and the points' y drift since (strip_rows_span); a version 3 or
+// 4 file walks whole strips until the next reorder, as those builds did.
+constexpr uint32_t kCheckpointVersion = 5;
 
 template <class T> void put(std::ostream& out, const T& v) {
   static_assert(std::is_trivially_destructible_v<T> && !std::is_pointer_v<T>);  // plain values (Eigen's fixed-size too)
@@ -88,6 +91,10 @@ void Simulation::save_state(std::ostream& out, uint32_t version) const {
     put_vector(out, strip_start_);
     put(out, reorders_);
   }
+  if (version >= 5) {
+    put_vector(out, strip_row_start_);
+    put(out, int32_t(strip_rows_)), put(out, drift_y_m_);
+  }
 }
 
 void Simulation::load_state(std::istream& in, const std::string& what) {
@@ -151,6 +158,20 @@ void Simulation::load_state(std::istream& in, const std::string& what) {
     reorders_ = r.get<Reorders>("reorder counts");
   } else {
     homes_stale_ = true;
+  }
+  strip_row_start_.clear(), strip_rows_ = 0, drift_y_m_ = 0.0;
+  if (version >= 5) {
+    r.get_vector(strip_row_start_, "strip rows");
+    strip_rows_ = r.get<int32_t>("strip row count");
+    drift_y_m_ = r.get<double>("drift since the reorder");
+    const size_t strips = strip_start_.size() - 1;
+    if (strip_rows_ <= 0 || strip_row_start_.size() != strips * size_t(strip_rows_) + 1)
+      r.fail("strip rows", std::to_string(strip_row_start_.size()) + " row starts for " + std::to_string(strips) + " strips");
+    for (size_t k = 0; k + 1 < strip_row_start_.size(); ++k)
+      if (strip_row_start_[k] > strip_row_start_[k + 1]) r.fail("strip rows", "not in order");
+    for (size_t s = 0; s <= strips; ++s)
+      if (strip_row_start_[s * size_t(strip_rows_)] != strip_start_[s]) r.fail("strip rows", "do not match the strip ranges");
+    if (!(drift_y_m_ >= 0.0)) r.fail("drift since the reorder", "negative or not a number");
   }
   if (in.peek() != std::char_traits<char>::eof()) r.fail("end", "data after the last item");
 }

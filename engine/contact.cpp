@@ -62,14 +62,21 @@ void Simulation::sample_body_fields() {
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const auto [frame_lo, frame_hi] = shape_bounds_m(scene_.bodies[b].shape);  // in the body's frame
     std::vector<std::pair<Vec2, double>> inside;  // point, depth below the surface (m)
+    std::vector<std::pair<uint32_t, uint32_t>> lattice;  // its column and row
+    BodySamples field;
     double deepest = 0.0;
-    for (double y = frame_lo.y() + 0.5 * h; y < frame_hi.y(); y += h)
-      for (double x = frame_lo.x() + 0.5 * h; x < frame_hi.x(); x += h) {
+    for (double y = frame_lo.y() + 0.5 * h; y < frame_hi.y(); y += h) {
+      field.row_y_m.push_back(y);
+      uint32_t column = 0;
+      for (double x = frame_lo.x() + 0.5 * h; x < frame_hi.x(); x += h, ++column) {
+        if (field.row_y_m.size() == 1) field.column_x_m.push_back(x);
         const double depth = -shape_sdf(scene_.bodies[b].shape, Vec2(x, y));
         if (depth <= 0.0) continue;
         inside.emplace_back(Vec2(x, y), depth);
+        lattice.emplace_back(column, uint32_t(field.row_y_m.size() - 1));
         deepest = std::max(deepest, depth);
       }
+    }
     const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
     const Shape& shape = scene_.bodies[b].shape;
     // across the body's travel (a path that turns keeps the direction of its middle), in the
@@ -104,10 +111,13 @@ void Simulation::sample_body_fields() {
       for (size_t k = 0; k < inside.size(); ++k) widest = std::max(widest, across_m[k] = depth_across(inside[k].first));
     // as with the inset, a body too thin for it keeps its middle
     const double side_inset = std::min(kBodyFieldSideInset * dx, 0.5 * widest);
-    std::vector<Vec2> samples;
     for (size_t k = 0; k < inside.size(); ++k)
-      if (inside[k].second >= inset && across_m[k] >= side_inset) samples.push_back(inside[k].first);
-    body_samples_m_.push_back(std::move(samples));
+      if (inside[k].second >= inset && across_m[k] >= side_inset) {
+        field.q_m.push_back(inside[k].first);
+        field.column.push_back(lattice[k].first);
+        field.row.push_back(lattice[k].second);
+      }
+    body_samples_.push_back(std::move(field));
   }
   body_sample_mass_kg_ = density * h * h;
   body_node_full_kg_ = density * dx * dx;  // the field at a node whose whole stencil it fills
@@ -224,74 +234,114 @@ void Simulation::contact_cell_fraction() {
     m_points.assign(box_nodes, 0.0);
     const bool free = scene_.bodies[b].dynamics.any_free();
     if (free) stencil_nn_[b].assign(box_nodes, Vec3(0.0, 0.0, 0.0));
-    // Both sums below run over bands of the box's node rows in parallel. Each band visits every
-    // sample and point in the same order as one pass would and adds only to its own rows, so each
-    // node's sum is the same whatever the bands: results are the same for any thread count (a
-    // point whose stencil spans two bands is worked out in both). Two bands per thread for balance,
-    // each at least four rows high; on one thread, one band and no work twice.
-    const int rows = j1 - j0 + 1, threads = tbb::this_task_arena::max_concurrency();
-    const int bands = threads == 1 ? 1 : std::clamp(std::min(rows / 4, 2 * threads), 1, rows);
-    auto band_rows = [&](int band) {
-      return std::pair<int, int>(j0 + int(int64_t(rows) * band / bands), j0 + int(int64_t(rows) * (band + 1) / bands) - 1);
+    // Both sums below run over bands of the box's nodes in parallel, across its longer side (a
+    // sample or point whose stencil spans two bands is worked out in both, and fewer do so when the
+    // bands are wide). Each band visits every sample and point in the same order as one pass would
+    // and adds only to its own nodes, so each node's sum is the same whatever the bands: results
+    // are the same for any thread count. Two bands per thread for balance, each at least four
+    // nodes across; on one thread, one band and no work twice.
+    const bool by_columns = i1 - i0 > j1 - j0;
+    const int across = by_columns ? i1 - i0 + 1 : j1 - j0 + 1, first_line = by_columns ? i0 : j0;
+    const int threads = tbb::this_task_arena::max_concurrency();
+    const int bands = threads == 1 ? 1 : std::clamp(std::min(across / 4, 2 * threads), 1, across);
+    struct Band {
+      int i0, i1, j0, j1;  // the nodes it adds to
+    };
+    auto band_nodes = [&](int band) {
+      const int a = first_line + int(int64_t(across) * band / bands);
+      const int z = first_line + int(int64_t(across) * (band + 1) / bands) - 1;
+      return by_columns ? Band{a, z, j0, j1} : Band{i0, i1, a, z};
     };
     // the body's field over its node box
     auto& field = body_node_mass_kg_[b];
     field.assign(box_nodes, 0.0);
-    tbb::parallel_for(0, bands, [&](int band) {
-      const auto [ra, rb] = band_rows(band);
-      for (const Vec2& q : body_samples_m_[b]) {
-        const Vec2 x = s.position_m + s.to_world(q);
-        const int base_y = K::base(x.y() * inv_dx);
-        if (base_y > rb || base_y + K::N - 1 < ra) continue;
-        double wx[K::N], wy[K::N], dw[K::N];
-        const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
-        const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
-        for (int j = std::max(by, ra); j <= std::min(by + K::N - 1, rb); ++j)
-          for (int i = std::max(bx, i0); i <= std::min(bx + K::N - 1, i1); ++i)
-            field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
+    const BodySamples& samples = body_samples_[b];
+    auto add_sample = [&](const Band& n, int bx, int by, const double* wx, const double* wy) {
+      if (by > n.j1 || by + K::N - 1 < n.j0 || bx > n.i1 || bx + K::N - 1 < n.i0) return;
+      for (int j = std::max(by, n.j0); j <= std::min(by + K::N - 1, n.j1); ++j)
+        for (int i = std::max(bx, n.i0); i <= std::min(bx + K::N - 1, n.i1); ++i)
+          field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
+    };
+    if (s.turns) {
+      tbb::parallel_for(0, bands, [&](int band) {
+        const Band n = band_nodes(band);
+        for (const Vec2& q : samples.q_m) {
+          const Vec2 x = s.position_m + s.to_world(q);
+          double wx[K::N], wy[K::N], dw[K::N];
+          const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
+          const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
+          add_sample(n, bx, by, wx, wy);
+        }
+      });
+    } else {
+      // a body that never turns keeps its samples' lattice on the grid's axes: the weights of a
+      // lattice column (row) are those of each of its samples, worked out once, and what is left
+      // is too little work to share out (one pass, the same sums)
+      const size_t columns = samples.column_x_m.size(), rows = samples.row_y_m.size();
+      std::vector<int> column_base(columns), row_base(rows);
+      std::vector<double> column_w(columns * K::N), row_w(rows * K::N);
+      double dw[K::N];
+      for (size_t a = 0; a < columns; ++a)
+        column_base[a] = K::weights((s.position_m.x() + samples.column_x_m[a]) * inv_dx, &column_w[a * K::N], dw, inv_dx);
+      for (size_t a = 0; a < rows; ++a)
+        row_base[a] = K::weights((s.position_m.y() + samples.row_y_m[a]) * inv_dx, &row_w[a * K::N], dw, inv_dx);
+      for (size_t k = 0; k < samples.q_m.size(); ++k) {
+        const uint32_t a = samples.column[k], c = samples.row[k];
+        add_sample(Band{i0, i1, j0, j1}, column_base[a], row_base[c], &column_w[a * K::N], &row_w[c * K::N]);
       }
-    });
+    }
     // each point in reach: marks its stencil if it touches the body, and adds to each node of its
     // stencil (weight x mass) the change that holds the node against the body along the point's
     // own face normal; points in strip order. Only nodes the body's field reaches: contact_nodes()
     // acts on no other (and clears their marks).
-    const auto [first, last] = body_strip_span<K>(s, reach, inv_dx, strips);
     tbb::parallel_for(0, bands, [&](int band) {
-      const auto [ra, rb] = band_rows(band);
-      for (uint32_t p = strip_start_[first]; p < strip_start_[last + 1]; ++p) {
-        const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
-        if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
-            r.y() > s.hi_m.y() + reach)
-          continue;
-        const int base_y = K::base(p_.y[p] * inv_dx);
-        if (base_y > rb || base_y + K::N - 1 < ra) continue;
-        double wx[K::N], wy[K::N], dw[K::N];
-        const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
-        const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
-        const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
-        const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
-        bool reached = false;  // over the whole stencil, not only this band's rows
-        for (int j = ja; j <= jb; ++j)
-          for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
-        if (!reached) continue;
-        const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
-        const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
-        const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
-        const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
-        const double mass = double(p_.mass[p]);
-        for (int j = std::max(ja, ra); j <= std::min(jb, rb); ++j)
-          for (int i = ia; i <= ib; ++i) {
-            const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
-            if (field[c] <= 0.0) continue;
-            if (touching) touched[k] = 1;
-            const double wm = wx[i - bx] * wy[j - by] * mass;
-            m_points[c] += wm;
-            Vec2 v(g_.node[k].vx, g_.node[k].vy);
-            const Vec2 v0 = v;
-            if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
-            dv[c] += wm * (v - v0);
-            if (free) stencil_nn_[b][c] += wm * nn;
-          }
+      const Band n = band_nodes(band);
+      // a point whose stencil meets the band's nodes lies within (first - N, last + 3) cells of
+      // them on each axis (a kernel's base is at most two cells below the point), and in the body's
+      // reach: only the strips and rows that could hold such points are walked, in the order one
+      // walk would take
+      const Vec2 lo = s.position_m + s.lo_m - Vec2(reach, reach), hi = s.position_m + s.hi_m + Vec2(reach, reach);
+      const double x_lo = std::max(lo.x(), (n.i0 - K::N) * dx), x_hi = std::min(hi.x(), (n.i1 + 3) * dx);
+      const double y_lo = std::max(lo.y(), (n.j0 - K::N) * dx), y_hi = std::min(hi.y(), (n.j1 + 3) * dx);
+      if (x_lo > x_hi || y_lo > y_hi) return;
+      const auto [first, last] = strip_span<K>(x_lo, x_hi, inv_dx, strips);
+      for (int strip = first; strip <= last; ++strip) {
+        const auto [pa, pb] = strip_rows_span<K>(strip, y_lo, y_hi);
+        for (uint32_t p = pa; p < pb; ++p) {
+          const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
+          if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
+              r.y() > s.hi_m.y() + reach)
+            continue;
+          const int base_x = K::base(p_.x[p] * inv_dx), base_y = K::base(p_.y[p] * inv_dx);
+          if (base_y > n.j1 || base_y + K::N - 1 < n.j0 || base_x > n.i1 || base_x + K::N - 1 < n.i0) continue;
+          double wx[K::N], wy[K::N], dw[K::N];
+          const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
+          const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
+          const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
+          const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
+          bool reached = false;  // over the whole stencil, not only this band's nodes
+          for (int j = ja; j <= jb; ++j)
+            for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
+          if (!reached) continue;
+          const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
+          const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
+          const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
+          const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
+          const double mass = double(p_.mass[p]);
+          for (int j = std::max(ja, n.j0); j <= std::min(jb, n.j1); ++j)
+            for (int i = std::max(ia, n.i0); i <= std::min(ib, n.i1); ++i) {
+              const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
+              if (field[c] <= 0.0) continue;
+              if (touching) touched[k] = 1;
+              const double wm = wx[i - bx] * wy[j - by] * mass;
+              m_points[c] += wm;
+              Vec2 v(g_.node[k].vx, g_.node[k].vy);
+              const Vec2 v0 = v;
+              if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
+              dv[c] += wm * (v - v0);
+              if (free) stencil_nn_[b][c] += wm * nn;
+            }
+        }
       }
     });
   }

@@ -34,8 +34,8 @@ void Simulation::find_contact_points() {
   const size_t nb = bodies_.size();
   const auto& P = p_;
   // candidates: points within two cells of a body's box (no point moves a cell in a step), found
-  // in the strips whose points may lie there (body_strip_span), then put in (particle, body) order so
-  // the list is the same for any thread count
+  // in the strips and rows whose points may lie there (body_strip_span, strip_rows_span), then put
+  // in (particle, body) order so the list is the same for any thread count
   const double reach = 2.0 * dx;
   const int strips = int(strip_start_.size()) - 1;
   contact_chunks_.resize(size_t(strips) * nb);
@@ -51,7 +51,9 @@ void Simulation::find_contact_points() {
     out.clear();
     if (strip < spans[b].first || strip > spans[b].second) return;
     const BodyState& s = bodies_[b];
-    for (uint32_t p = strip_start_[strip]; p < strip_start_[strip + 1]; ++p) {
+    const double y_lo = s.position_m.y() + s.lo_m.y() - reach, y_hi = s.position_m.y() + s.hi_m.y() + reach;
+    const auto [first, end] = strip_rows_span<K>(strip, y_lo, y_hi);
+    for (uint32_t p = first; p < end; ++p) {
       const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
       if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||
           q.y() > s.hi_m.y() + reach)

@@ -40,6 +40,11 @@ void Simulation::reorder_particles() {
   std::partial_sum(start.begin(), start.end(), start.begin());
   strip_start_.resize(size_t(strips) + 1);
   for (int s = 0; s <= strips; ++s) strip_start_[size_t(s)] = start[size_t(s) * strip_keys];
+  // where each row of each strip starts, for searches bounded in y (strip_rows_span)
+  strip_rows_ = rows;
+  strip_row_start_.resize(size_t(strips) * size_t(rows) + 1);
+  for (size_t r = 0; r < strip_row_start_.size(); ++r) strip_row_start_[r] = start[r * W::width];
+  drift_y_m_ = 0.0;
   set_home_strips();
   for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);
   // the contact list (kept for the next step's warm start) follows its particles
@@ -71,6 +76,21 @@ void Simulation::reorder_particles() {
   });
 }
 
+// The points of `strip` that may now lie between y_lo_m and y_hi_m, as one range in memory order:
+// the rows they could have been sorted into at the reorder (drift_y_m_ either side, and a row more
+// for round-off). A superset: callers keep their own test.
+template <class K>
+std::pair<uint32_t, uint32_t> Simulation::strip_rows_span(int strip, double y_lo_m, double y_hi_m) const {
+  // resumed from a checkpoint without rows: the whole strip until the next reorder
+  if (strip_row_start_.empty()) return {strip_start_[size_t(strip)], strip_start_[size_t(strip) + 1]};
+  const double inv = 1.0 / g_.dx;
+  auto row = [&](double y) { return std::clamp(K::base(y * inv) + Grid::kPad, 0, strip_rows_ - 1); };
+  const int r0 = std::max(row(y_lo_m - drift_y_m_) - 1, 0);
+  const int r1 = std::min(row(y_hi_m + drift_y_m_) + 1, strip_rows_ - 1);
+  const size_t at = size_t(strip) * size_t(strip_rows_);
+  return {strip_row_start_[at + size_t(r0)], strip_row_start_[at + size_t(r1) + 1]};
+}
+
 template <class K>
 bool Simulation::strips_hold_for() const {
   if (homes_stale_) return false;
@@ -90,6 +110,9 @@ void Simulation::set_home_strips() {
 template void Simulation::reorder_particles<LinearKernel>();
 template void Simulation::reorder_particles<QuadraticKernel>();
 template void Simulation::reorder_particles<CubicKernel>();
+template std::pair<uint32_t, uint32_t> Simulation::strip_rows_span<LinearKernel>(int, double, double) const;
+template std::pair<uint32_t, uint32_t> Simulation::strip_rows_span<QuadraticKernel>(int, double, double) const;
+template std::pair<uint32_t, uint32_t> Simulation::strip_rows_span<CubicKernel>(int, double, double) const;
 template bool Simulation::strips_hold_for<LinearKernel>() const;
 template bool Simulation::strips_hold_for<QuadraticKernel>() const;
 template bool Simulation::strips_hold_for<CubicKernel>() const;

@@ -302,13 +302,15 @@ void Simulation::particles_update(bool g2p, bool constitutive) {
   });
   if (!g2p) return;
   stats_.projected_particles = 0;
-  double vmax2 = 0.0;
+  double vmax2 = 0.0, dy_max_m = 0.0;
   strayed_ = false;
   for (const G2PLocal& loc : locals) {
     strayed_ |= loc.strayed;
     stats_.projected_particles += loc.projected;
     vmax2 = std::max(vmax2, loc.vmax2);
+    dy_max_m = std::max(dy_max_m, loc.dy_max_m);
   }
+  drift_y_m_ += dy_max_m;
   stats_.max_speed_m_s = std::sqrt(vmax2);
 }
 

@@ -9,6 +9,7 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/fields.hpp"
@@ -199,7 +200,7 @@ class Simulation {
   // the same scene and loaded continues bit-identically. load_state throws std::runtime_error
   // naming `what` when the stream is not a checkpoint of this build and scene size.
   // `version` below the current writes an older layout (2: no strip ranges; 3: bodies without
-  // angles), for the tests that check old checkpoints are still read
+  // angles; 4: no strip rows), for the tests that check old checkpoints are still read
   void save_state(std::ostream& out, uint32_t version = 0) const;
   void load_state(std::istream& in, const std::string& what);
 
@@ -230,6 +231,7 @@ class Simulation {
   struct G2PLocal {
     int64_t projected = 0;
     double vmax2 = 0.0;
+    double dy_max_m = 0.0;  // largest move in y (strip_rows_span's drift)
     bool strayed = false;  // a point left its strip's window (the step ends with a reorder)
   };
   template <class Kernel, bool Flip> void g2p_range(size_t begin, size_t end, G2PLocal& loc);
@@ -268,6 +270,14 @@ class Simulation {
   // (strayed_) and the step then reorders.
   std::vector<uint32_t> strip_start_;
   std::vector<uint16_t> home_strip_;
+  // Within a strip the reorder sorts the points by stencil row: row r of strip s starts at
+  // strip_row_start_[s * strip_rows_ + r]. No point has moved more than drift_y_m_ in y since
+  // (G2P adds each step's largest move), so a search for the points of a band of y need only walk
+  // the rows that band could have held then (strip_rows_span).
+  std::vector<uint32_t> strip_row_start_;
+  int strip_rows_ = 0;
+  double drift_y_m_ = 0.0;
+  template <class Kernel> std::pair<uint32_t, uint32_t> strip_rows_span(int strip, double y_lo_m, double y_hi_m) const;
   bool strayed_ = false, homes_stale_ = false;
   Reorders reorders_;
   void (Simulation::*reorder_)() = nullptr;
@@ -284,7 +294,14 @@ class Simulation {
   // cell-fraction contact: per body, the nodes a point has touched; its field's sample points
   // (body frame, m) and their mass (kg per metre); the field's nodal mass over the body's node box
   std::vector<std::vector<uint8_t>> touched_;
-  std::vector<std::vector<Vec2>> body_samples_m_;
+  // a body's field samples lie on a lattice in its frame: sample k at (column_x_m[column[k]],
+  // row_y_m[row[k]]), in rows from the bottom
+  struct BodySamples {
+    std::vector<Vec2> q_m;
+    std::vector<double> column_x_m, row_y_m;
+    std::vector<uint32_t> column, row;
+  };
+  std::vector<BodySamples> body_samples_;
   std::vector<std::vector<Vec2>> body_corners_m_;  // outline corners, body frame (bounds at any angle)
   // free bodies, per node of the body's box: the part of the node's correction that follows the
   // body's velocity (a symmetric 2x2 projector times the share: xx, xy, yy), and (cell_fraction)

@@ -48,13 +48,17 @@ inline NodeBox body_node_box(const BodyState& s, const Grid& g) {
           std::max(-Grid::kPad, int(std::floor(lo.y())) - 1), std::min(g.ny + Grid::kPad, int(std::ceil(hi.y())) + 1)};
 }
 
-// The first and last P2G strips whose points may lie within `reach_m` of a body's box: a strip
-// either side more than the points there now, since a point may have strayed from its strip.
-template <class K> inline std::pair<int, int> body_strip_span(const BodyState& s, double reach_m, double inv_dx, int strips) {
+// The first and last P2G strips whose points may lie between x_lo_m and x_hi_m: a strip either
+// side more than the points there now, since a point may have strayed from its strip.
+template <class K> inline std::pair<int, int> strip_span(double x_lo_m, double x_hi_m, double inv_dx, int strips) {
   using W = StripWindow<K>;
-  const int first = W::of_base(K::base((s.position_m.x() + s.lo_m.x() - reach_m) * inv_dx), strips);
-  const int last = W::of_base(K::base((s.position_m.x() + s.hi_m.x() + reach_m) * inv_dx), strips);
+  const int first = W::of_base(K::base(x_lo_m * inv_dx), strips), last = W::of_base(K::base(x_hi_m * inv_dx), strips);
   return {std::max(first - 1, 0), std::min(last + 1, strips - 1)};
+}
+
+// The strips whose points may lie within `reach_m` of a body's box.
+template <class K> inline std::pair<int, int> body_strip_span(const BodyState& s, double reach_m, double inv_dx, int strips) {
+  return strip_span<K>(s.position_m.x() + s.lo_m.x() - reach_m, s.position_m.x() + s.hi_m.x() + reach_m, inv_dx, strips);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // G2P: grid velocities and the affine matrix back to the particles, the FLIP blend, advection and
 // the safety net that puts a point left inside a body back on its surface.
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <immintrin.h>
 #include <type_traits>
@@ -135,6 +136,8 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     y = out ? lo : y, uy = out ? (uy < 0.0 ? zero : uy) : uy;
     out = y > hy;
     y = out ? hy : y, uy = out ? (0.0 < uy ? zero : uy) : uy;
+    const V dy = y - yp;  // strip_rows_span's drift
+    for (size_t l = 0; l < count; ++l) loc.dy_max_m = std::max(loc.dy_max_m, std::abs(dy[l]));
     store(X, x);
     store(Y, y);
     store(VX, ux);
@@ -274,6 +277,7 @@ void Simulation::g2p_range(size_t begin, size_t end, G2PLocal& loc) {
     P.vx[p] = v.x();
     P.vy[p] = v.y();
     loc.vmax2 = std::max(loc.vmax2, fma1(v.x(), v.x(), v.y() * v.y()));  // as the four-wide path's
+    loc.dy_max_m = std::max(loc.dy_max_m, std::abs(x.y() - yp));
     loc.strayed |= !StripWindow<K>::holds(home_strip_[p], K::base(x.x() * inv_dx));
   }
 }
