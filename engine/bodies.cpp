@@ -89,6 +89,90 @@ std::vector<std::vector<Vec2>> shape_outline(const Shape& s, int circle_segments
   return loops;
 }
 
+std::vector<std::vector<Vec2>> shape_boundary(const Shape& s, int cells) {
+  if (s.kind != Shape::Kind::Union) return shape_outline(s);
+  // marching squares on the distance field: a crossing point on each lattice edge whose ends differ
+  // in sign, joined within each cell; every crossing then has two neighbours and the segments chain
+  // into loops
+  auto [lo, hi] = shape_bounds_m(s);
+  const double h = (hi - lo).maxCoeff() / cells;
+  lo -= Vec2(2 * h, 2 * h), hi += Vec2(2 * h, 2 * h);
+  const int nx = int(std::ceil((hi.x() - lo.x()) / h)), ny = int(std::ceil((hi.y() - lo.y()) / h));
+  auto at = [&](int i, int j) { return Vec2(lo.x() + i * h, lo.y() + j * h); };
+  std::vector<double> f(size_t(nx + 1) * size_t(ny + 1));
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) f[size_t(j) * size_t(nx + 1) + size_t(i)] = shape_sdf(s, at(i, j));
+  auto F = [&](int i, int j) { return f[size_t(j) * size_t(nx + 1) + size_t(i)]; };
+  // crossing ids: 2 k for the edge from node k to its right, 2 k + 1 to the node above
+  auto node = [&](int i, int j) { return int64_t(j) * (nx + 1) + i; };
+  auto crossing = [&](int64_t id) {
+    const int64_t k = id / 2;
+    const int i = int(k % (nx + 1)), j = int(k / (nx + 1)), di = id % 2 ? 0 : 1, dj = 1 - di;
+    const double a = F(i, j), b = F(i + di, j + dj), t = a / (a - b);
+    return Vec2(at(i, j) + t * (at(i + di, j + dj) - at(i, j)));
+  };
+  std::vector<std::pair<int64_t, int64_t>> links;  // per crossing: its two neighbours (-1 unset)
+  std::vector<int64_t> slot(size_t(2 * (nx + 1) * (ny + 1)), -1);
+  auto join = [&](int64_t a, int64_t b) {
+    for (int64_t c : {a, b}) {
+      if (slot[size_t(c)] < 0) slot[size_t(c)] = int64_t(links.size()), links.emplace_back(-1, -1);
+      auto& l = links[size_t(slot[size_t(c)])];
+      (l.first < 0 ? l.first : l.second) = c == a ? b : a;
+    }
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const bool a = F(i, j) < 0, b = F(i + 1, j) < 0, c = F(i + 1, j + 1) < 0, d = F(i, j + 1) < 0;
+      const int64_t B = 2 * node(i, j), T = 2 * node(i, j + 1), L = 2 * node(i, j) + 1, R = 2 * node(i + 1, j) + 1;
+      std::vector<int64_t> cut;
+      if (a != b) cut.push_back(B);
+      if (b != c) cut.push_back(R);
+      if (c != d) cut.push_back(T);
+      if (d != a) cut.push_back(L);
+      if (cut.size() == 2) {
+        join(cut[0], cut[1]);
+      } else if (cut.size() == 4) {  // a saddle: the cell's centre decides which corners connect
+        const bool centre = 0.25 * (F(i, j) + F(i + 1, j) + F(i + 1, j + 1) + F(i, j + 1)) < 0;
+        if (centre == a) join(B, R), join(T, L);  // corners b and d cut off
+        else join(L, B), join(R, T);              // corners a and c cut off
+      }
+    }
+  std::vector<std::vector<Vec2>> loops;
+  std::vector<char> used(slot.size(), 0);
+  for (int64_t start = 0; start < int64_t(slot.size()); ++start) {
+    if (slot[size_t(start)] < 0 || used[size_t(start)]) continue;
+    std::vector<Vec2> loop;
+    for (int64_t prev = -1, c = start; c >= 0 && !used[size_t(c)];) {
+      used[size_t(c)] = 1;
+      loop.push_back(crossing(c));
+      const auto& l = links[size_t(slot[size_t(c)])];
+      const int64_t next = l.first != prev ? l.first : l.second;
+      prev = c, c = next;
+    }
+    // fewer points where the contour runs straight (within a tenth of the lattice spacing)
+    std::vector<Vec2> kept;
+    for (size_t k = 0; k < loop.size(); ++k) {
+      const Vec2 &p = kept.empty() ? loop.back() : kept.back(), &q = loop[k], &r = loop[(k + 1) % loop.size()];
+      const Vec2 e = r - p;
+      const double off = e.norm() > 0 ? std::abs(e.x() * (q - p).y() - e.y() * (q - p).x()) / e.norm() : 0.0;
+      if (off > 0.1 * h || k == 0) kept.push_back(q);
+    }
+    // the inside on the left: counter-clockwise around the body, clockwise around a hole
+    if (kept.size() >= 3) {
+      // probed off the longest segment: a short one may cut a corner, where half a lattice
+      // spacing outwards is still inside
+      size_t a = 0;
+      for (size_t k = 1; k < kept.size(); ++k)
+        if ((kept[(k + 1) % kept.size()] - kept[k]).norm() > (kept[(a + 1) % kept.size()] - kept[a]).norm()) a = k;
+      const Vec2 &p = kept[a], &q = kept[(a + 1) % kept.size()];
+      const Vec2 mid = 0.5 * (p + q), along = (q - p).normalized();
+      if (shape_sdf(s, mid + 0.5 * h * Vec2(-along.y(), along.x())) > 0) std::reverse(kept.begin(), kept.end());
+      loops.push_back(std::move(kept));
+    }
+  }
+  return loops;
+}
+
 double shape_min_size(const Shape& s) {
   switch (s.kind) {
     case Shape::Kind::Circle:

@@ -12,6 +12,10 @@ double shape_sdf(const Shape& s, const Vec2& q);
 Vec2 shape_normal(const Shape& s, const Vec2& q, double h);
 // Outline polygon(s) of the shape in the body frame, flattened into one closed loop per part.
 std::vector<std::vector<Vec2>> shape_outline(const Shape& s, int circle_segments = 48);
+// The shape's boundary as drawn (body frame, closed counter-clockwise loops, holes clockwise): the
+// outline for a circle, box or polygon; for a union, the zero contour of its distance field on a
+// lattice of `cells` along its longer side (the parts' inner edges are not boundary).
+std::vector<std::vector<Vec2>> shape_boundary(const Shape& s, int cells = 256);
 // Smallest feature size (circle diameter, box min side, polygon min extent).
 double shape_min_size(const Shape& s);
 // Area (m^2 per metre) and second moment of area about the body's origin (m^4 per metre), by

@@ -414,7 +414,7 @@ ParticleView Simulation::particle_view() const {
 std::vector<BodyOutline> Simulation::body_outlines() const {
   std::vector<BodyOutline> out;
   for (size_t b = 0; b < bodies_.size(); ++b) {
-    const auto loops = shape_outline(scene_.bodies[b].shape);
+    const auto loops = shape_boundary(scene_.bodies[b].shape);
     for (size_t k = 0; k < loops.size(); ++k) {
       BodyOutline o;
       o.name = scene_.bodies[b].name + (k ? "#" + std::to_string(k) : "");

@@ -65,11 +65,19 @@ void draw_scene(ImDrawList* dl, const Scene& s, const SceneLayout& l, float canv
   for (const Body& b : s.bodies) {
     // at its start angle, turned about its origin as the solver turns it
     const Eigen::Rotation2Dd turn(b.start_angle_rad);
-    for (const auto& loop : shape_outline(b.shape)) {
+    auto screen = [&](const std::vector<Vec2>& loop) {
       std::vector<ImVec2> pts;
       for (const Vec2& q : loop) pts.push_back(px(l, turn * q + b.start_m));
-      // every part is convex (circle, box, convex polygon), so each loop fills as one polygon
+      return pts;
+    };
+    // every part is convex (circle, box, convex polygon), so each part fills as one polygon; the
+    // line is the body's boundary (a union's inner edges are not drawn)
+    for (const auto& loop : shape_outline(b.shape)) {
+      const auto pts = screen(loop);
       dl->AddConvexPolyFilled(pts.data(), int(pts.size()), IM_COL32(90, 96, 110, 255));
+    }
+    for (const auto& loop : shape_boundary(b.shape)) {
+      const auto pts = screen(loop);
       dl->AddPolyline(pts.data(), int(pts.size()), IM_COL32(20, 20, 20, 255), ImDrawFlags_Closed, 1.5f);
     }
     const ImVec2 c = px(l, b.start_m);

@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "engine/bodies.hpp"
 #include "engine/scene/scene_io.hpp"
 #include "engine/simulation.hpp"
 #include "tests/engine/test_scenes.hpp"
@@ -454,4 +455,53 @@ TEST(BodyDynamics, FootingRestsWhereTheBedCarriesItBetweenThePlatesDepthAtItsLoa
   EXPECT_GE(d_rest, d_qs - 0.5 * dx);
   if (!std::isnan(d_E)) EXPECT_LE(d_rest, d_E);
   else ADD_FAILURE() << "no energy bound within 35 mm";
+}
+
+// A union is drawn by its boundary, not by its parts' edges: four overlapping boxes making a square
+// frame give two loops, the outer counter-clockwise and the hole clockwise, on the shape's zero
+// distance to within the lattice spacing, enclosing the frame's area to within the spacing times
+// the perimeter.
+TEST(BodyShape, AUnionIsDrawnByItsBoundaryWithTheHoleTurningTheOtherWay) {
+  Shape frame;
+  frame.kind = Shape::Kind::Union;
+  const double L = 0.1, t = 0.02;  // outer side and wall thickness (m)
+  auto box = [](Vec2 size_m, Vec2 offset_m) {
+    Shape b;
+    b.kind = Shape::Kind::Box, b.size_m = size_m, b.offset_m = offset_m;
+    return b;
+  };
+  frame.parts = {box({L, t}, {0, -(L - t) / 2}), box({L, t}, {0, (L - t) / 2}),
+                 box({t, L}, {-(L - t) / 2, 0}), box({t, L}, {(L - t) / 2, 0})};
+  const int cells = 200;
+  const auto loops = shape_boundary(frame, cells);
+  ASSERT_EQ(loops.size(), 2u);
+  const double h = (L + 4 * L / cells) / cells;  // the lattice spacing, padding included (upper bound)
+  std::vector<double> signed_area;
+  for (const auto& loop : loops) {
+    double a = 0.0;
+    for (size_t k = 0; k < loop.size(); ++k) {
+      const Vec2 &p = loop[k], &q = loop[(k + 1) % loop.size()];
+      a += 0.5 * (p.x() * q.y() - q.x() * p.y());
+      EXPECT_LT(std::abs(shape_sdf(frame, p)), h) << "a boundary point off the surface";
+    }
+    signed_area.push_back(a);
+  }
+  std::sort(signed_area.begin(), signed_area.end());
+  const double hole = (L - 2 * t) * (L - 2 * t);
+  EXPECT_NEAR(signed_area[0], -hole, 4 * (L - 2 * t) * h);
+  EXPECT_NEAR(signed_area[1], L * L, 4 * L * h);
+  // a single convex part is its own outline
+  EXPECT_EQ(shape_boundary(frame.parts[0]).size(), 1u);
+  // the leg template's C of 12 quadrilaterals is one loop enclosing the union's area
+  const Shape leg = template_scene("leg").bodies.at(0).shape;
+  const auto leg_loops = shape_boundary(leg, cells);
+  ASSERT_EQ(leg_loops.size(), 1u);
+  const auto [lo, hi] = shape_bounds_m(leg);
+  const double h_leg = 1.04 * (hi - lo).maxCoeff() / cells;
+  double area = 0.0, perimeter = 0.0;
+  for (size_t k = 0; k < leg_loops[0].size(); ++k) {
+    const Vec2 &p = leg_loops[0][k], &q = leg_loops[0][(k + 1) % leg_loops[0].size()];
+    area += 0.5 * (p.x() * q.y() - q.x() * p.y()), perimeter += (q - p).norm();
+  }
+  EXPECT_NEAR(area, shape_mass_properties(leg).area_m2, perimeter * h_leg);
 }
