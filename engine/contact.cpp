@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -123,9 +124,24 @@ void Simulation::sample_body_fields() {
   body_node_full_kg_ = density * dx * dx;  // the field at a node whose whole stencil it fills
 }
 
+// The walls and the bodies act on the same nodes only where a body's node box reaches a boundary
+// line; elsewhere the walls (a few thousand nodes, serial) run beside the body contact, whose
+// body field is serial too, so on two threads neither waits for the other. Node and cell_fraction
+// contact touch only their box's nodes; particle contact scatters a cell or more beyond it, so it
+// keeps the order bodies, then walls.
 void Simulation::bodies_and_walls() {
-  if (!bodies_.empty()) (this->*contact_)();
-  contact_walls();
+  if (bodies_.empty()) return contact_walls();
+  bool apart = scene_.solver.contact != ContactMethod::Particle;
+  for (const BodyState& s : bodies_) {
+    const auto [i0, i1, j0, j1] = body_node_box(s, g_);
+    apart = apart && i0 > 0 && i1 < g_.nx && j0 > 0 && j1 < g_.ny;
+  }
+  if (apart) {
+    tbb::parallel_invoke([&] { (this->*contact_)(); }, [&] { contact_walls(); });
+  } else {
+    (this->*contact_)();
+    contact_walls();
+  }
 }
 
 // Node contact: every grid node inside a body takes the body's normal velocity (Coulomb slip
