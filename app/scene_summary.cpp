@@ -45,12 +45,13 @@ std::string scene_summary(const Scene& s, const std::string& source) {
        << " cells across its travel, max speed " << fmt("%g", motion_max_speed_m_s(b.motion)) << " m/s";
     if (omega > 0.0) os << ", turning at up to " << fmt("%g", omega) << " rad/s";
     os << ", " << contact_method_name(s.solver.contact) << " contact";
-    // a body that turns has no side inset to its field (engine/README.md): the plate bias is not its
-    if (omega > 0.0 || b.dynamics.free_angle)
-      os << " (it turns: its field acts up to a cell beyond its surface)";
+    // a body driven to turn has no side inset to its field (engine/README.md); the plate bias was
+    // measured on plates that do not turn
+    if (omega > 0.0 && s.solver.contact == ContactMethod::CellFraction)
+      os << " (driven to turn: its field acts up to a cell beyond its surface)";
     else if (cells < 8.0)
       os << " (under 8 cells across: its force depends strongly on dx and the contact method)";
-    else if (std::abs(bias) >= 0.01)
+    else if (omega == 0.0 && !b.dynamics.free_angle && std::abs(bias) >= 0.01)
       os << " (a plate this many cells across reads ~" << fmt("%.0f", 100 * std::abs(bias)) << "% "
          << (bias < 0 ? "low" : "high") << ": engine/README.md, \"Body contact\")";
     os << "\n";

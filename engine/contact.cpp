@@ -81,47 +81,116 @@ void Simulation::sample_body_fields() {
     const double inset = std::min(kBodyFieldInset * dx, 0.5 * deepest);
     const Shape& shape = scene_.bodies[b].shape;
     // across the body's travel (a path that turns keeps the direction of its middle), in the
-    // body's frame; none for a body that spins: no one direction is across its travel. A body
-    // held at an angle keeps it (without, a plate tilted 0.001 degrees acted a side inset wider:
-    // +15% force on plate_intrusion)
+    // body's frame. A body held at an angle keeps it (without, a plate tilted 0.001 degrees acted a
+    // side inset wider: +15% force on plate_intrusion); a body that spins has no one direction
+    // across its travel, so its rim's inset turns (below)
     const Body& body = scene_.bodies[b];
     const bool spins = body.dynamics.free_angle || motion_max_angular_speed_rad_s(body.motion) > 0.0;
-    Vec2 travel = spins ? Vec2(0.0, 0.0) : travel_direction(scene_, body);
-    if (!spins && body.start_angle_rad != 0.0) {
+    // so far only where the media turn it (a free angle): a driven spin (the wheel, the leg) keeps
+    // no side inset, since what the turning inset does to the wheel's drawbar pull is not settled
+    // (engine/README.md, "The side inset of a body that turns")
+    const bool turning_inset = body.dynamics.free_angle;
+    Vec2 travel = travel_direction(scene_, body);
+    if (body.start_angle_rad != 0.0) {
       const double c = std::cos(body.start_angle_rad), s = std::sin(body.start_angle_rad);
       travel = Vec2(c * travel.x() + s * travel.y(), -s * travel.x() + c * travel.y());
     }
-    const Vec2 across(-travel.y(), travel.x());
-    // distance from q to the surface along +-across (bisection on the SDF; the body is inside its box)
-    auto depth_across = [&](const Vec2& q) {
+    // distances from q to the surface along -across and +across (bisection on the SDF; the body
+    // is inside its box)
+    auto reach_across = [&](const Vec2& q, const Vec2& across) {
       const double far = (frame_hi - frame_lo).norm();
-      double depth = far;
+      std::pair<double, double> reach;
       for (double sign : {-1.0, 1.0}) {
         double in = 0.0, out = far;
         for (int k = 0; k < 40; ++k) {
           const double mid = 0.5 * (in + out);
           (shape_sdf(shape, q + sign * mid * across) < 0.0 ? in : out) = mid;
         }
-        depth = std::min(depth, out);
+        (sign < 0 ? reach.first : reach.second) = out;
       }
-      return depth;
+      return reach;
     };
-    std::vector<double> across_m(inside.size(), 0.0);
-    double widest = 0.0;
-    if (across.squaredNorm() > 0.0)
-      for (size_t k = 0; k < inside.size(); ++k) widest = std::max(widest, across_m[k] = depth_across(inside[k].first));
-    // as with the inset, a body too thin for it keeps its middle
-    const double side_inset = std::min(kBodyFieldSideInset * dx, 0.5 * widest);
-    for (size_t k = 0; k < inside.size(); ++k)
-      if (inside[k].second >= inset && across_m[k] >= side_inset) {
+    auto depth_across = [&](const Vec2& q, const Vec2& across) {
+      const auto [a, b] = reach_across(q, across);
+      return std::min(a, b);
+    };
+    // as with the inset, a body too thin for the side inset keeps its middle
+    auto side_inset_across = [&](const Vec2& across) {
+      double widest = 0.0;
+      for (size_t k = 0; k < inside.size() && widest < 2.0 * kBodyFieldSideInset * dx; ++k)
+        widest = std::max(widest, depth_across(inside[k].first, across));
+      return std::min(kBodyFieldSideInset * dx, 0.5 * widest);
+    };
+    if (!spins) {
+      const Vec2 across(-travel.y(), travel.x());
+      std::vector<double> across_m(inside.size(), 0.0);
+      if (across.squaredNorm() > 0.0)
+        for (size_t k = 0; k < inside.size(); ++k) across_m[k] = depth_across(inside[k].first, across);
+      const double side_inset = across.squaredNorm() > 0.0 ? side_inset_across(across) : 0.0;
+      for (size_t k = 0; k < inside.size(); ++k)
+        if (inside[k].second >= inset && across_m[k] >= side_inset) {
+          field.q_m.push_back(inside[k].first);
+          field.column.push_back(lattice[k].first);
+          field.row.push_back(lattice[k].second);
+        }
+    } else {
+      // every sample deeper than the inset; those within a side inset (and the half sample of the
+      // weight's ramp) of the surface keep their depth and chord across each direction. A body
+      // thin across a direction keeps the middle half of its chord there (for one that does not
+      // spin, the thinnest part's: above), so a thin curved leg slicing edge-on stays in the field
+      field.rest_direction = travel;
+      for (size_t k = 0; k < inside.size(); ++k) {
+        if (inside[k].second < inset) continue;
+        if (turning_inset && inside[k].second < kBodyFieldSideInset * dx + 0.5 * h) {
+          field.rim.push_back(uint32_t(field.q_m.size()));
+          for (int d = 0; d < kInsetDirections; ++d) {
+            const double a = M_PI * d / kInsetDirections;
+            const auto [minus, plus] = reach_across(inside[k].first, Vec2(-std::sin(a), std::cos(a)));
+            field.rim_across_m.push_back(std::min(minus, plus));
+            field.rim_chord_m.push_back(minus + plus);
+          }
+        }
         field.q_m.push_back(inside[k].first);
         field.column.push_back(lattice[k].first);
         field.row.push_back(lattice[k].second);
       }
+      if (turning_inset) field.weight.assign(field.q_m.size(), 1.0);
+    }
     body_samples_.push_back(std::move(field));
   }
   body_sample_mass_kg_ = density * h * h;
   body_node_full_kg_ = density * dx * dx;  // the field at a node whose whole stencil it fills
+}
+
+// A spinning body's rim samples, this step: the direction of their own velocity (v + omega z x q,
+// in the body's frame; at rest, the direction the body's load or motion gives) picks their depth
+// and chord across it from the tables, interpolated between directions, and they weigh
+// in over a ramp one sample spacing wide about the inset. The field then changes smoothly as the
+// body turns; on a body moving straight the ramp keeps and drops the samples the fixed inset does.
+void Simulation::weigh_rim(size_t b) {
+  BodySamples& f = body_samples_[b];
+  if (f.rim.empty()) return;
+  const BodyState& s = bodies_[b];
+  const double h = g_.dx / kBodySamplesPerCell;
+  const Vec2 v(s.cos_a * s.velocity_m_s.x() + s.sin_a * s.velocity_m_s.y(),
+               -s.sin_a * s.velocity_m_s.x() + s.cos_a * s.velocity_m_s.y());
+  for (size_t r = 0; r < f.rim.size(); ++r) {
+    const Vec2& q = f.q_m[f.rim[r]];
+    Vec2 u = v + s.omega_rad_s * Vec2(-q.y(), q.x());
+    if (u.squaredNorm() == 0.0) u = f.rest_direction;
+    double w = 1.0;
+    if (u.squaredNorm() > 0.0) {
+      double t = std::atan2(u.y(), u.x()) / M_PI * kInsetDirections;  // in (-M, M]; a direction and
+      if (t < 0.0) t += kInsetDirections;                               // its opposite share a row
+      const int d0 = std::min(int(t), kInsetDirections - 1), d1 = (d0 + 1) % kInsetDirections;
+      const double a = t - d0;
+      const double *across = &f.rim_across_m[r * kInsetDirections], *chord = &f.rim_chord_m[r * kInsetDirections];
+      const double depth = (1.0 - a) * across[d0] + a * across[d1];
+      const double inset = std::min(kBodyFieldSideInset * g_.dx, 0.25 * ((1.0 - a) * chord[d0] + a * chord[d1]));
+      w = std::clamp((depth - inset) / h + 0.5, 0.0, 1.0);
+    }
+    f.weight[f.rim[r]] = w;
+  }
 }
 
 // The walls and the bodies act on the same nodes only where a body's node box reaches a boundary
@@ -272,21 +341,22 @@ void Simulation::contact_cell_fraction() {
     auto& field = body_node_mass_kg_[b];
     field.assign(box_nodes, 0.0);
     const BodySamples& samples = body_samples_[b];
-    auto add_sample = [&](const Band& n, int bx, int by, const double* wx, const double* wy) {
+    auto add_sample = [&](const Band& n, int bx, int by, const double* wx, const double* wy, double m) {
       if (by > n.j1 || by + K::N - 1 < n.j0 || bx > n.i1 || bx + K::N - 1 < n.i0) return;
       for (int j = std::max(by, n.j0); j <= std::min(by + K::N - 1, n.j1); ++j)
         for (int i = std::max(bx, n.i0); i <= std::min(bx + K::N - 1, n.i1); ++i)
-          field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * body_sample_mass_kg_;
+          field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * m;
     };
     if (s.turns) {
+      weigh_rim(b);
       tbb::parallel_for(0, bands, [&](int band) {
         const Band n = band_nodes(band);
-        for (const Vec2& q : samples.q_m) {
-          const Vec2 x = s.position_m + s.to_world(q);
+        for (size_t k = 0; k < samples.q_m.size(); ++k) {
+          const Vec2 x = s.position_m + s.to_world(samples.q_m[k]);
           double wx[K::N], wy[K::N], dw[K::N];
           const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
           const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
-          add_sample(n, bx, by, wx, wy);
+          add_sample(n, bx, by, wx, wy, samples.weight.empty() ? body_sample_mass_kg_ : samples.weight[k] * body_sample_mass_kg_);
         }
       });
     } else {
@@ -303,7 +373,8 @@ void Simulation::contact_cell_fraction() {
         row_base[a] = K::weights((s.position_m.y() + samples.row_y_m[a]) * inv_dx, &row_w[a * K::N], dw, inv_dx);
       for (size_t k = 0; k < samples.q_m.size(); ++k) {
         const uint32_t a = samples.column[k], c = samples.row[k];
-        add_sample(Band{i0, i1, j0, j1}, column_base[a], row_base[c], &column_w[a * K::N], &row_w[c * K::N]);
+        add_sample(Band{i0, i1, j0, j1}, column_base[a], row_base[c], &column_w[a * K::N], &row_w[c * K::N],
+                   body_sample_mass_kg_);
       }
     }
     // each point in reach: marks its stencil if it touches the body, and adds to each node of its

@@ -216,6 +216,7 @@ class Simulation {
  private:
   void seed_beds();
   void sample_body_fields();
+  void weigh_rim(size_t b);
   void clear_grid();
   template <class Kernel, bool Flip> void particles_to_grid();
   void grid_update();
@@ -296,10 +297,20 @@ class Simulation {
   std::vector<std::vector<uint8_t>> touched_;
   // a body's field samples lie on a lattice in its frame: sample k at (column_x_m[column[k]],
   // row_y_m[row[k]]), in rows from the bottom
+  // A body that spins has no one direction across its travel: its side inset turns with the
+  // local velocity of its material. Samples nearer its surface than the side inset (the rim)
+  // keep their depth across each of kInsetDirections directions over half a turn (body frame),
+  // and each step weighs in by how far they lie inside the inset across their own velocity.
+  static constexpr int kInsetDirections = 32;
   struct BodySamples {
     std::vector<Vec2> q_m;
     std::vector<double> column_x_m, row_y_m;
     std::vector<uint32_t> column, row;
+    std::vector<uint32_t> rim;                      // samples whose weight turns (spinning bodies)
+    std::vector<double> rim_across_m;               // rim.size() x kInsetDirections: nearer side
+    std::vector<double> rim_chord_m;                // and the chord through the sample
+    Vec2 rest_direction{0.0, 0.0};                  // body frame: where the rim looks at rest
+    std::vector<double> weight;                     // this step's, per sample (spinning bodies)
   };
   std::vector<BodySamples> body_samples_;
   std::vector<std::vector<Vec2>> body_corners_m_;  // outline corners, body frame (bounds at any angle)
