@@ -161,6 +161,9 @@ TEST(DpmPlowing, DenseBedFluctuatesAtLeastTwiceAsMuchAndDragsHarder) {
   RecordProperty("dense_mean_N_per_m", std::to_string(b.mean_N_per_m));
   RecordProperty("loose_relative_fluctuation", std::to_string(a.relative_fluctuation));
   RecordProperty("dense_relative_fluctuation", std::to_string(b.relative_fluctuation));
+  std::printf("case 3: relative fluctuation %.3f at phi 0.63 vs %.3f at 0.57 (%.1fx); mean drag %.1f vs %.1f N/m\n",
+              b.relative_fluctuation, a.relative_fluctuation, b.relative_fluctuation / a.relative_fluctuation,
+              b.mean_N_per_m, a.mean_N_per_m);
   EXPECT_GE(b.relative_fluctuation, 2.0 * a.relative_fluctuation)
       << "loose " << a.relative_fluctuation << ", dense " << b.relative_fluctuation;
   // the dense bed is stronger (friction 0.55 before it softens, vs at most 0.40 for the loose bed
