@@ -134,10 +134,11 @@ void Simulation::sample_body_fields() {
           field.row.push_back(lattice[k].second);
         }
     } else {
-      // every sample deeper than the inset; those within a side inset (and the half sample of the
-      // weight's ramp) of the surface keep their depth and chord across each direction. A body
-      // thin across a direction keeps the middle half of its chord there (for one that does not
-      // spin, the thinnest part's: above), so a thin curved leg slicing edge-on stays in the field
+      // every sample deeper than the inset; with a turning inset, those within a side inset (and
+      // the half sample of the weight's ramp) of the surface keep their depth and chord across each
+      // direction. A body thin across a direction keeps the middle half of its chord there (for one
+      // that does not spin, the thinnest part's: above): with one side inset for all its parts, a
+      // thin curved leg slicing edge-on dropped out of its field
       field.rest_direction = travel;
       for (size_t k = 0; k < inside.size(); ++k) {
         if (inside[k].second < inset) continue;

@@ -295,25 +295,26 @@ class Simulation {
   // cell-fraction contact: per body, the nodes a point has touched; its field's sample points
   // (body frame, m) and their mass (kg per metre); the field's nodal mass over the body's node box
   std::vector<std::vector<uint8_t>> touched_;
+  // A body with a free angle has no one direction across its travel: its side inset turns with
+  // the local velocity of its material. Samples nearer its surface than the side inset (the rim)
+  // keep their depth and chord across each of kInsetDirections directions over half a turn (body
+  // frame), and each step weigh in by how far they lie inside the inset across their own velocity.
+  static constexpr int kInsetDirections = 32;
   // a body's field samples lie on a lattice in its frame: sample k at (column_x_m[column[k]],
   // row_y_m[row[k]]), in rows from the bottom
-  // A body that spins has no one direction across its travel: its side inset turns with the
-  // local velocity of its material. Samples nearer its surface than the side inset (the rim)
-  // keep their depth across each of kInsetDirections directions over half a turn (body frame),
-  // and each step weighs in by how far they lie inside the inset across their own velocity.
-  static constexpr int kInsetDirections = 32;
   struct BodySamples {
     std::vector<Vec2> q_m;
     std::vector<double> column_x_m, row_y_m;
     std::vector<uint32_t> column, row;
-    std::vector<uint32_t> rim;                      // samples whose weight turns (spinning bodies)
+    std::vector<uint32_t> rim;                      // samples whose weight turns (free angle)
     std::vector<double> rim_across_m;               // rim.size() x kInsetDirections: nearer side
     std::vector<double> rim_chord_m;                // and the chord through the sample
     Vec2 rest_direction{0.0, 0.0};                  // body frame: where the rim looks at rest
-    std::vector<double> weight;                     // this step's, per sample (spinning bodies)
+    std::vector<double> weight;                     // this step's, per sample (free angle)
   };
   std::vector<BodySamples> body_samples_;
   std::vector<std::vector<Vec2>> body_corners_m_;  // outline corners, body frame (bounds at any angle)
+  std::vector<std::vector<std::vector<Vec2>>> body_boundaries_m_;  // shape_boundary, body frame (drawn)
   // free bodies, per node of the body's box: the part of the node's correction that follows the
   // body's velocity (a symmetric 2x2 projector times the share: xx, xy, yy), and (cell_fraction)
   // its stencil sums of mass x n n^T

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "engine/bodies.hpp"
+#include "engine/scene/scene_io.hpp"
 #include "render/imgui_offscreen.hpp"
 
 namespace furrow::render {
@@ -41,7 +42,8 @@ ImU32 wall_colour(Wall::Kind k) {
 }
 
 // Domain, grid, beds, walls and bodies on the background draw list (canvas pixels).
-void draw_scene(ImDrawList* dl, const Scene& s, const SceneLayout& l, float canvas_w, float canvas_h) {
+void draw_scene(ImDrawList* dl, const Scene& s, const std::vector<std::vector<std::vector<Vec2>>>& boundaries,
+                const SceneLayout& l, float canvas_w, float canvas_h) {
   dl->AddRectFilled(ImVec2(0, 0), ImVec2(canvas_w, canvas_h), IM_COL32(40, 44, 52, 255));
   const Vec2 size(s.domain.width_m, s.domain.height_m);
   const ImVec2 lo = px(l, Vec2(0, size.y())), hi = px(l, Vec2(size.x(), 0));
@@ -62,7 +64,8 @@ void draw_scene(ImDrawList* dl, const Scene& s, const SceneLayout& l, float canv
                                                        {&s.walls.top, {0, size.y()}, size}};
   for (const auto& w : walls)
     if (w.w->kind != Wall::Kind::Open) dl->AddLine(px(l, w.a), px(l, w.b), wall_colour(w.w->kind), 4.0f);
-  for (const Body& b : s.bodies) {
+  for (size_t k = 0; k < s.bodies.size(); ++k) {
+    const Body& b = s.bodies[k];
     // at its start angle, turned about its origin as the solver turns it
     const Eigen::Rotation2Dd turn(b.start_angle_rad);
     auto screen = [&](const std::vector<Vec2>& loop) {
@@ -76,7 +79,7 @@ void draw_scene(ImDrawList* dl, const Scene& s, const SceneLayout& l, float canv
       const auto pts = screen(loop);
       dl->AddConvexPolyFilled(pts.data(), int(pts.size()), IM_COL32(90, 96, 110, 255));
     }
-    for (const auto& loop : shape_boundary(b.shape)) {
+    for (const auto& loop : boundaries[k]) {
       const auto pts = screen(loop);
       dl->AddPolyline(pts.data(), int(pts.size()), IM_COL32(20, 20, 20, 255), ImDrawFlags_Closed, 1.5f);
     }
@@ -185,9 +188,18 @@ RgbImage SceneView::render(const Scene& scene, const ScenePanel& panel, const Vi
   const bool first = !ui_;
   if (first) ui_ = std::make_unique<ImGuiOffscreen>(width_, height_);
   const SceneLayout l = layout(scene);
+  // a union's boundary takes ~10 ms to trace: again only for a body whose shape changed
+  const nlohmann::json bodies = scene_to_json(scene)["bodies"];
+  boundary_shapes_.resize(scene.bodies.size()), boundaries_.resize(scene.bodies.size());
+  for (size_t k = 0; k < scene.bodies.size(); ++k) {
+    std::string shape = bodies[k]["shape"].dump();
+    if (shape == boundary_shapes_[k]) continue;
+    boundary_shapes_[k] = std::move(shape);
+    boundaries_[k] = shape_boundary(scene.bodies[k].shape);
+  }
   bool committed = false, preview_clicked = false;
   auto draw = [&] {
-    draw_scene(ImGui::GetBackgroundDrawList(), scene, l, float(panel_x0()), float(height_));
+    draw_scene(ImGui::GetBackgroundDrawList(), scene, boundaries_, l, float(panel_x0()), float(height_));
     committed |= draw_panel(panel, float(panel_x0()), float(panel_w_), float(height_), &preview_clicked);
   };
   const float clear[3] = {0.16f, 0.17f, 0.2f};

@@ -104,6 +104,9 @@ class SceneView {
   bool focus_pending_ = false;    // give the text field the keyboard in the next frame
   bool focus_requested_ = false;  // asked for in this frame: it takes it in the next
   std::map<std::string, Eigen::Vector2d> rows_;  // row centres of the last frame
+  // per body: its shape (as JSON) and the boundary drawn for it, traced again only when it changes
+  std::vector<std::string> boundary_shapes_;
+  std::vector<std::vector<std::vector<Eigen::Vector2d>>> boundaries_;
 };
 
 }  // namespace furrow::render
