@@ -522,7 +522,8 @@ TEST(FrameRenderer, PanelRowsDrawTorqueAndDepthUnderTheForceChart) {
 // 0.15 s (under a second). Its forces.csv and scene.json give torque and depth rows for the movie
 // (the wheel turns and its y is free) and speed and angle for the inspector; the driven wheel's
 // torque (~0.3 N m/m) is signal, far above the row's floor; the wheel sinks; a stored frame drawn
-// with that panel shows both traces in the wheel's colour.
+// with that panel shows both traces in the wheel's colour. At 4 kg/m, the template's load until
+// 2026-12-07, so that it sinks well past the bound by 0.15 s (at the template's 2 kg/m, 0.29 mm).
 TEST(FrameRenderer, AWheelRunsPanelDrawsItsTorqueAndDepthRows) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("furrow_wheel_rows_" + std::to_string(::getpid()));
@@ -530,7 +531,8 @@ TEST(FrameRenderer, AWheelRunsPanelDrawsItsTorqueAndDepthRows) {
   const Scene scene = parse_scene_text(find_scene_template("wheel")->text, "<template wheel>",
                                        {"domain.dx_m=0.006", "solver.end_time_s=0.15", "outputs.frame_interval_s=0.05",
                                         "outputs.force_interval_s=0.005", "outputs.average_window.from_s=0",
-                                        "outputs.average_window.to_s=0.15", "solver.threads=1"});
+                                        "outputs.average_window.to_s=0.15", "solver.threads=1",
+                                        "bodies.0.mass_kg_per_m=4.0"});
   RunOptions options;
   options.out_dir = dir.string();
   options.write_paraview = false;
