@@ -166,10 +166,11 @@ TEST_F(BenchCli, ScalingTableHasARowPerThreadCountWhosePhasesAddUpToTheStep) {
       continue;
     }
     EXPECT_DOUBLE_EQ(cells[0][k].second, 1.0);
-    if (cells[1][k].first >= 0.001)  // large enough for the printed digits to give the ratio to ~10%
+    if (cells[1][k].first >= 0.001) {  // large enough for the printed digits to give the ratio to ~10%
       EXPECT_NEAR(cells[1][k].second, cells[0][k].first / cells[1][k].first,
                   0.1 * cells[0][k].first / cells[1][k].first + 0.01)
           << r.out;
+    }
   }
   EXPECT_FALSE(std::filesystem::exists(path("calibration.json")));
   // a list that is not one, and the scaling options without --threads, are refused by name

@@ -60,7 +60,7 @@ TEST(EditPanel, ATypedValueIsCheckedAsTypedAndSetLikeTheScriptsSet) {
 
   // an invalid value: the message is the script's, shown while typing; the scene stays
   EditorState script = furrow::cli::open_scene_for_edit("plate_intrusion");
-  const json scripted = furrow::cli::apply_edit(script, furrow::cli::SetKey{"domain.dx_m=-0.5"}, nullptr);
+  const json scripted = furrow::cli::apply_edit(script, furrow::cli::SetKey{"domain.dx_m=-0.5", {}}, nullptr);
   ASSERT_EQ(scripted["ok"], false);
   EXPECT_TRUE(event(s, view, typed("-0.5")).is_null());
   EXPECT_EQ(s.typing_key, "domain.dx_m");

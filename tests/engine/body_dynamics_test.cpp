@@ -234,8 +234,12 @@ TEST(BodyDynamics, WheelDrawbarPullAndSinkageRiseWithSlip) {
     pull /= span, torque /= span, sinkage /= span;
     std::printf("slip %+.2f: drawbar pull %.2f N/m, torque %.4f N m/m, sinkage %.2f mm\n", slip, pull, torque,
                 1e3 * sinkage);
-    if (slip < 0) EXPECT_LT(pull, 0.0);
-    if (slip > 0.4) EXPECT_GT(pull, 0.0);
+    if (slip < 0) {
+      EXPECT_LT(pull, 0.0);
+    }
+    if (slip > 0.4) {
+      EXPECT_GT(pull, 0.0);
+    }
     EXPECT_GT(pull, last_pull + 1.0);  // measured -5.76, +0.47, +2.48 N/m
     // the media resist the drive (torque counter-clockwise against a clockwise spin), more the
     // more it slips (measured 0.038, 0.171, 0.273 N m/m)
@@ -243,7 +247,9 @@ TEST(BodyDynamics, WheelDrawbarPullAndSinkageRiseWithSlip) {
     // sinkage: 0.41, 0.58, 2.03 mm measured; no fall beyond a twentieth of a cell, and a rise of a
     // quarter cell over the sweep
     EXPECT_GT(sinkage, last_sinkage - s.domain.dx_m / 20);
-    if (slip > 0.4) EXPECT_GT(sinkage, first_sinkage + s.domain.dx_m / 4);
+    if (slip > 0.4) {
+      EXPECT_GT(sinkage, first_sinkage + s.domain.dx_m / 4);
+    }
     if (slip < 0) first_sinkage = sinkage;
     last_pull = pull, last_sinkage = sinkage, last_torque = torque;
   }
@@ -297,7 +303,9 @@ TEST(BodyDynamics, LegSweptBackThroughTheBedIsPushedForwardAndTheMediaResistItsT
     EXPECT_EQ(with, 0);
     EXPECT_GT(fy_down / span_down, 0.0);
     EXPECT_LT(fy_up / span_up, 0.0);
-    if (sweep == 0) EXPECT_LT(std::abs(peak_angle), M_PI / 6);
+    if (sweep == 0) {
+      EXPECT_LT(std::abs(peak_angle), M_PI / 6);
+    }
   }
   // measured 23.7 and -42.6 N/m
   EXPECT_GT(mean_thrust[0], 0.0);

@@ -455,7 +455,9 @@ TEST(SceneDefaults, SceneFileWithoutContactResolvesToCellFraction) {
             furrow::ContactMethod::Node);
   for (const auto& n : template_names()) {
     const json t = template_json(n);
-    if (t.contains("bodies") && !t["bodies"].empty()) EXPECT_TRUE(t["solver"].contains("contact")) << n;
+    if (t.contains("bodies") && !t["bodies"].empty()) {
+      EXPECT_TRUE(t["solver"].contains("contact")) << n;
+    }
   }
 }
 
