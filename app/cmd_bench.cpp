@@ -70,7 +70,7 @@ double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases, int64
   }
   if (phases) {
     const PhaseSeconds& ph = sim.phase_seconds();
-    *phases = {ph.clear - before.clear,     ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
+    *phases = {ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
                ph.g2p - before.g2p,         ph.constitutive - before.constitutive,
                ph.reorder - before.reorder, ph.g2p_constitutive - before.g2p_constitutive};
   }
@@ -120,9 +120,9 @@ int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps,
               particles, steps, repeats);
   std::printf("wall seconds per phase over the steps, and (in brackets) the speedup over %d thread%s\n",
               rows.front().threads, rows.front().threads == 1 ? "" : "s");
-  const char* names[] = {"clear", "p2g", "grid", "contact", "g2p+const", "reorder", "step"};
+  const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
   auto phases = [](const PhaseSeconds& ph) {
-    return std::array<double, 7>{ph.clear, ph.p2g,     ph.grid,      ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,
+    return std::array<double, 6>{ph.p2g,     ph.grid,      ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,
                                  ph.reorder, ph.total()};
   };
   std::printf("%7s %19s", "threads", "M particle-steps/s");
@@ -188,8 +188,8 @@ int bench_main(const Parsed& p) {
                  cores == 1 ? "" : "s", seconds);
   const char* shape_names[] = {"linear", "quadratic", "cubic"};
   // G2P and the constitutive update run as one pass over the particles (one column)
-  std::printf("%-10s %-5s %7s %19s   share of a step (%%): %5s %5s %5s %7s %9s %7s\n", "shape", "model", "threads",
-              "M particle-steps/s", "clear", "p2g", "grid", "contact", "g2p+const", "reorder");
+  std::printf("%-10s %-5s %7s %19s   share of a step (%%): %5s %5s %7s %9s %7s\n", "shape", "model", "threads",
+              "M particle-steps/s", "p2g", "grid", "contact", "g2p+const", "reorder");
   for (ShapeFunction shape : {ShapeFunction::Linear, ShapeFunction::Quadratic, ShapeFunction::Cubic})
     for (bool dpm : {false, true})
       for (int threads : thread_counts) {
@@ -200,8 +200,8 @@ int bench_main(const Parsed& p) {
         c.entries.push_back({shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate});
         if (shape == ShapeFunction::Quadratic && !dpm && threads == thread_counts.back()) reference_rate = rate;
         auto share = [&](double phase) { return 100.0 * phase / ph.total(); };
-        std::printf("%-10s %-5s %7d %19.2f   %21s %5.1f %5.1f %5.1f %7.1f %9.1f %7.1f\n", shape_names[int(shape)],
-                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.clear), share(ph.p2g), share(ph.grid),
+        std::printf("%-10s %-5s %7d %19.2f   %21s %5.1f %5.1f %7.1f %9.1f %7.1f\n", shape_names[int(shape)],
+                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.p2g), share(ph.grid),
                     share(ph.contact), share(ph.g2p + ph.constitutive + ph.g2p_constitutive), share(ph.reorder));
         std::fflush(stdout);
       }
@@ -231,7 +231,7 @@ Command command_bench() {
           "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
           "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
-          "share of a step each phase takes (grid clear, P2G, grid update, body and wall contact, G2P with\n"
+          "share of a step each phase takes (P2G with the grid's zeroing, grid update, body and wall contact, G2P with\n"
           "the constitutive update (one pass), particle reorder); then quadratic NDPM on all cores at\n"
           "dx 1.25 mm (16 times the points) for how the rate falls on larger beds; and\n"
           "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"

@@ -590,7 +590,7 @@ RunSummary SceneRun::finish() {
   j["threads"] = scene.solver.threads > 0 ? scene.solver.threads : tbb::info::default_concurrency();
   j["peak_resident_bytes"] = peak_resident_bytes();
   const PhaseSeconds& ph = sim.phase_seconds();
-  j["phase_seconds"] = {{"clear", ph.clear}, {"p2g", ph.p2g}, {"grid", ph.grid}, {"contact", ph.contact},
+  j["phase_seconds"] = {{"p2g", ph.p2g}, {"grid", ph.grid}, {"contact", ph.contact},
                         {"g2p", ph.g2p}, {"constitutive", ph.constitutive},
                         {"g2p_constitutive", ph.g2p_constitutive}, {"reorder", ph.reorder}};
   j["reorders"] = {{"scheduled", sim.reorders().scheduled}, {"strayed", sim.reorders().strayed},

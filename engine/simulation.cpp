@@ -25,7 +25,7 @@ namespace furrow {
 
 namespace {
 
-// grid nodes per task of the grid passes (clear, grid update): 2048 x 40 B = 80 kB, so the 34k nodes
+// grid nodes per task of the grid update: 2048 x 40 B = 80 kB, so the 34k nodes
 // of the bench bed (dx 5 mm) make 17 tasks; at 16384 they made 3, two threads split them 2:1
 constexpr size_t kGridGrain = 2048;
 // particles G2P and the constitutive update take in turn when fused: their ~20 arrays of a block
@@ -210,9 +210,7 @@ void Simulation::step() {
   dt_s_ = next_dt_s();
   if (homes_stale_) arena_->execute([&] { (this->*reorder_)(); });
   arena_->execute([&] {
-    clear_grid();
-    lap(phase_s_.clear);
-    (this->*p2g_)();
+    (this->*p2g_)();  // zeroes the grid as it scatters
     lap(phase_s_.p2g);
     grid_update();
     lap(phase_s_.grid);
@@ -254,12 +252,6 @@ bool Simulation::finished() const {
 double Simulation::lead_body_travel_m() const {
   const int b = reference_body_index(scene_);
   return b < 0 ? 0.0 : (bodies_[size_t(b)].position_m - scene_.bodies[size_t(b)].start_m).norm();
-}
-
-void Simulation::clear_grid() {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), kGridGrain), [&](const auto& r) {
-    std::fill(g_.node.begin() + r.begin(), g_.node.begin() + r.end(), GridNode{});
-  });
 }
 
 void Simulation::grid_update() {

@@ -131,9 +131,9 @@ struct StepStats {
 // Wall-clock seconds spent in each phase of step(), summed over the run (for profiles: where a
 // step's time goes; they never feed back into the results).
 struct PhaseSeconds {
-  double clear = 0, p2g = 0, grid = 0, contact = 0, g2p = 0, constitutive = 0, reorder = 0;
+  double p2g = 0, grid = 0, contact = 0, g2p = 0, constitutive = 0, reorder = 0;
   double g2p_constitutive = 0;  // G2P and constitutive update fused into one pass (the default)
-  double total() const { return clear + p2g + grid + contact + g2p + constitutive + g2p_constitutive + reorder; }
+  double total() const { return p2g + grid + contact + g2p + constitutive + g2p_constitutive + reorder; }
 };
 
 // A material point near a body's surface and its contact impulses (particle contact).
@@ -217,7 +217,6 @@ class Simulation {
   void seed_beds();
   void sample_body_fields();
   void weigh_rim(size_t b);
-  void clear_grid();
   template <class Kernel, bool Flip> void particles_to_grid();
   void grid_update();
   void bodies_and_walls();
