@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -157,6 +158,9 @@ void Simulation::sample_body_fields() {
       }
       if (turning_inset) field.weight.assign(field.q_m.size(), 1.0);
     }
+    field.row_start.assign(field.row_y_m.size() + 1, 0);
+    for (uint32_t r : field.row) ++field.row_start[r + 1];
+    std::partial_sum(field.row_start.begin(), field.row_start.end(), field.row_start.begin());
     body_samples_.push_back(std::move(field));
   }
   body_sample_mass_kg_ = density * h * h;
@@ -195,8 +199,8 @@ void Simulation::weigh_rim(size_t b) {
 }
 
 // The walls and the bodies act on the same nodes only where a body's node box reaches a boundary
-// line; elsewhere the walls (a few thousand nodes, serial) run beside the body contact, whose
-// body field is serial too, so on two threads neither waits for the other. Node and cell_fraction
+// line; elsewhere the walls (a few thousand nodes, serial) run beside the body contact, so on
+// two threads one thread starts the walls while the other starts the body's bands. Node and cell_fraction
 // contact touch only their box's nodes; particle contact scatters a cell or more beyond it, so it
 // keeps the order bodies, then walls.
 void Simulation::bodies_and_walls() {
@@ -324,12 +328,14 @@ void Simulation::contact_cell_fraction() {
     // sample or point whose stencil spans two bands is worked out in both, and fewer do so when the
     // bands are wide). Each band visits every sample and point in the same order as one pass would
     // and adds only to its own nodes, so each node's sum is the same whatever the bands: results
-    // are the same for any thread count. Two bands per thread for balance, each at least four
-    // nodes across; on one thread, one band and no work twice.
+    // are the same for any thread count. One band per thread, each at least four nodes across; on
+    // one thread, one band and no work twice. Both sums run in one parallel region (a band works
+    // out the field N - 1 nodes beyond its own too, where its points' stencils reach): the phase is
+    // tens of microseconds a step, and each region pays a wake-up of the other threads.
     const bool by_columns = i1 - i0 > j1 - j0;
     const int across = by_columns ? i1 - i0 + 1 : j1 - j0 + 1, first_line = by_columns ? i0 : j0;
     const int threads = tbb::this_task_arena::max_concurrency();
-    const int bands = threads == 1 ? 1 : std::clamp(std::min(across / 4, 2 * threads), 1, across);
+    const int bands = threads == 1 ? 1 : std::clamp(std::min(across / 4, threads), 1, across);
     struct Band {
       int i0, i1, j0, j1;  // the nodes it adds to
     };
@@ -338,52 +344,84 @@ void Simulation::contact_cell_fraction() {
       const int z = first_line + int(int64_t(across) * (band + 1) / bands) - 1;
       return by_columns ? Band{a, z, j0, j1} : Band{i0, i1, a, z};
     };
-    // the body's field over its node box
+    // the body's field over its node box; with several bands each adds up its own copy
     auto& field = body_node_mass_kg_[b];
     field.assign(box_nodes, 0.0);
+    if (bands > 1) band_field_.resize(size_t(bands));
     const BodySamples& samples = body_samples_[b];
-    auto add_sample = [&](const Band& n, int bx, int by, const double* wx, const double* wy, double m) {
+    auto add_sample = [&](double* out, const Band& n, int bx, int by, const double* wx, const double* wy, double m) {
+      if (by >= n.j0 && by + K::N - 1 <= n.j1 && bx >= n.i0 && bx + K::N - 1 <= n.i1) {
+        // the whole stencil in the band (most samples): fixed trip counts, the same sums
+        double* const row0 = out + size_t(by - j0) * width + size_t(bx - i0);
+        for (int j = 0; j < K::N; ++j)
+          for (int i = 0; i < K::N; ++i) row0[size_t(j) * width + size_t(i)] += wx[i] * wy[j] * m;
+        return;
+      }
       if (by > n.j1 || by + K::N - 1 < n.j0 || bx > n.i1 || bx + K::N - 1 < n.i0) return;
       for (int j = std::max(by, n.j0); j <= std::min(by + K::N - 1, n.j1); ++j)
         for (int i = std::max(bx, n.i0); i <= std::min(bx + K::N - 1, n.i1); ++i)
-          field[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * m;
+          out[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * m;
     };
-    if (s.turns) {
-      weigh_rim(b);
-      tbb::parallel_for(0, bands, [&](int band) {
-        const Band n = band_nodes(band);
-        for (size_t k = 0; k < samples.q_m.size(); ++k) {
-          const Vec2 x = s.position_m + s.to_world(samples.q_m[k]);
-          double wx[K::N], wy[K::N], dw[K::N];
-          const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
-          const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
-          add_sample(n, bx, by, wx, wy, samples.weight.empty() ? body_sample_mass_kg_ : samples.weight[k] * body_sample_mass_kg_);
-        }
-      });
-    } else {
-      // a body that never turns keeps its samples' lattice on the grid's axes: the weights of a
-      // lattice column (row) are those of each of its samples, worked out once, and what is left
-      // is too little work to share out (one pass, the same sums)
-      const size_t columns = samples.column_x_m.size(), rows = samples.row_y_m.size();
-      std::vector<int> column_base(columns), row_base(rows);
-      std::vector<double> column_w(columns * K::N), row_w(rows * K::N);
+    // a body that never turns keeps its samples' lattice on the grid's axes: the weights of a
+    // lattice column (row) are those of each of its samples, worked out once. The samples lie in
+    // rows from the bottom, each row by column, and the bases ascend with the column (row), so the
+    // samples whose stencil meets a band's nodes are a run of rows and, in each, a run of columns:
+    // a band walks only those, in the one pass's order
+    const size_t columns = s.turns ? 0 : samples.column_x_m.size(), rows = s.turns ? 0 : samples.row_y_m.size();
+    std::vector<int> column_base(columns), row_base(rows);
+    std::vector<double> column_w(columns * K::N), row_w(rows * K::N);
+    {
       double dw[K::N];
       for (size_t a = 0; a < columns; ++a)
         column_base[a] = K::weights((s.position_m.x() + samples.column_x_m[a]) * inv_dx, &column_w[a * K::N], dw, inv_dx);
       for (size_t a = 0; a < rows; ++a)
         row_base[a] = K::weights((s.position_m.y() + samples.row_y_m[a]) * inv_dx, &row_w[a * K::N], dw, inv_dx);
-      for (size_t k = 0; k < samples.q_m.size(); ++k) {
-        const uint32_t a = samples.column[k], c = samples.row[k];
-        add_sample(Band{i0, i1, j0, j1}, column_base[a], row_base[c], &column_w[a * K::N], &row_w[c * K::N],
-                   body_sample_mass_kg_);
-      }
     }
+    if (s.turns) weigh_rim(b);
+    auto add_field = [&](double* out, const Band& n) {
+      if (s.turns) {
+        for (size_t k = 0; k < samples.q_m.size(); ++k) {
+          const Vec2 x = s.position_m + s.to_world(samples.q_m[k]);
+          double wx[K::N], wy[K::N], dw[K::N];
+          const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
+          const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
+          add_sample(out, n, bx, by, wx, wy, samples.weight.empty() ? body_sample_mass_kg_ : samples.weight[k] * body_sample_mass_kg_);
+        }
+        return;
+      }
+      // lattice lines whose stencil (base .. base + N - 1) meets the band's lo .. hi
+      auto meeting = [](const std::vector<int>& base, int lo, int hi) {
+        return std::pair(uint32_t(std::lower_bound(base.begin(), base.end(), lo - (K::N - 1)) - base.begin()),
+                         uint32_t(std::upper_bound(base.begin(), base.end(), hi) - base.begin()));
+      };
+      const auto [a0, a1] = meeting(column_base, n.i0, n.i1);
+      const auto [c0, c1] = meeting(row_base, n.j0, n.j1);
+      const uint32_t* const column = samples.column.data();
+      for (uint32_t c = c0; c < c1; ++c) {
+        const uint32_t *const row_first = column + samples.row_start[c], *const row_end = column + samples.row_start[c + 1];
+        for (const uint32_t* k = std::lower_bound(row_first, row_end, a0); k < row_end && *k < a1; ++k)
+          add_sample(out, n, column_base[*k], row_base[c], &column_w[*k * K::N], &row_w[c * K::N], body_sample_mass_kg_);
+      }
+    };
     // each point in reach: marks its stencil if it touches the body, and adds to each node of its
     // stencil (weight x mass) the change that holds the node against the body along the point's
     // own face normal; points in strip order. Only nodes the body's field reaches: contact_nodes()
     // acts on no other (and clears their marks).
     tbb::parallel_for(0, bands, [&](int band) {
       const Band n = band_nodes(band);
+      const double* f = field.data();  // the field at the band's nodes and N - 1 beyond
+      if (bands == 1) {
+        add_field(field.data(), n);
+      } else {
+        std::vector<double>& own = band_field_[size_t(band)];
+        own.assign(box_nodes, 0.0);
+        const int m = K::N - 1;
+        add_field(own.data(), Band{std::max(n.i0 - m, i0), std::min(n.i1 + m, i1), std::max(n.j0 - m, j0), std::min(n.j1 + m, j1)});
+        for (int j = n.j0; j <= n.j1; ++j)
+          std::copy_n(own.data() + size_t(j - j0) * width + size_t(n.i0 - i0), n.i1 - n.i0 + 1,
+                      field.data() + size_t(j - j0) * width + size_t(n.i0 - i0));
+        f = own.data();
+      }
       // a point whose stencil meets the band's nodes lies within (first - N, last + 3) cells of
       // them on each axis (a kernel's base is at most two cells below the point), and in the body's
       // reach: only the strips and rows that could hold such points are walked, in the order one
@@ -409,7 +447,7 @@ void Simulation::contact_cell_fraction() {
           const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
           bool reached = false;  // over the whole stencil, not only this band's nodes
           for (int j = ja; j <= jb; ++j)
-            for (int i = ia; i <= ib; ++i) reached |= field[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
+            for (int i = ia; i <= ib; ++i) reached |= f[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
           if (!reached) continue;
           const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
           const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
@@ -419,7 +457,7 @@ void Simulation::contact_cell_fraction() {
           for (int j = std::max(ja, n.j0); j <= std::min(jb, n.j1); ++j)
             for (int i = std::max(ia, n.i0); i <= std::min(ib, n.i1); ++i) {
               const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
-              if (field[c] <= 0.0) continue;
+              if (f[c] <= 0.0) continue;
               if (touching) touched[k] = 1;
               const double wm = wx[i - bx] * wy[j - by] * mass;
               m_points[c] += wm;

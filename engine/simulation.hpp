@@ -305,6 +305,7 @@ class Simulation {
     std::vector<Vec2> q_m;
     std::vector<double> column_x_m, row_y_m;
     std::vector<uint32_t> column, row;
+    std::vector<uint32_t> row_start;  // row c's samples are [row_start[c], row_start[c + 1]), by column
     std::vector<uint32_t> rim;                      // samples whose weight turns (free angle)
     std::vector<double> rim_across_m;               // rim.size() x kInsetDirections: nearer side
     std::vector<double> rim_chord_m;                // and the chord through the sample
@@ -321,6 +322,7 @@ class Simulation {
   double body_sample_mass_kg_ = 0.0;
   double body_node_full_kg_ = 0.0;
   std::vector<std::vector<double>> body_node_mass_kg_;
+  std::vector<std::vector<double>> band_field_;  // cell_fraction: each band's own copy of the field (scratch)
   // cell-fraction contact, per body over its node box: the points' summed velocity changes (kg m/s)
   // and the mass they came with (kg), both weighted by the points' weights
   std::vector<std::vector<Vec2>> stencil_dv_kg_m_s_;
