@@ -143,7 +143,8 @@ template <bool Dilatancy, bool Track, bool Rate>
 void Simulation::constitutive_range(size_t begin, size_t end) {
   if constexpr (!Rate)
     if (by_four_) begin = constitutive_by_four<Dilatancy, Track>(begin, end);
-  std::vector<PlasticityModel<Dilatancy, Rate>> models;  // once per block of points: cheap
+  if (begin == end) return;  // the four-wide pass took every point: no models to build (a heap allocation per block)
+  std::vector<PlasticityModel<Dilatancy, Rate>> models;
   for (const auto& m : materials_) models.push_back({m});
   for (size_t p = begin; p < end; ++p) constitutive_point<Dilatancy, Track, Rate>(p, models[p_.material[p]]);
 }
