@@ -1,4 +1,4 @@
-// A Simulation's set-up, step() (the algorithm, phase by phase), the grid's clear and update, the
+// A Simulation's set-up, step() (the algorithm, phase by phase), the grid update, the
 // bodies' motion, and what the run reads back. The phases' own files: engine/README.md, "A step,
 // phase by phase".
 #include "engine/simulation.hpp"

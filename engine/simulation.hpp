@@ -1,6 +1,6 @@
 // Explicit plane-strain MPM over an immutable Scene. One step reads like the algorithm:
-//   clear_grid -> particles_to_grid -> grid_update -> bodies_and_walls -> grid_to_particles
-//   -> constitutive_update -> advance_bodies
+//   particles_to_grid (zeroing the grid as it goes) -> grid_update -> bodies_and_walls
+//   -> grid_to_particles -> constitutive_update -> advance_bodies
 // Particles and grid are structures of arrays; the shape-function kernel and the material law are
 // chosen once per scene (templates), so the hot loops carry no per-particle feature branches.
 #pragma once
