@@ -70,9 +70,10 @@ double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases, int64
   }
   if (phases) {
     const PhaseSeconds& ph = sim.phase_seconds();
-    *phases = {ph.p2g - before.p2g, ph.grid - before.grid, ph.contact - before.contact,
-               ph.g2p - before.g2p,         ph.constitutive - before.constitutive,
-               ph.reorder - before.reorder, ph.g2p_constitutive - before.g2p_constitutive};
+    *phases = {ph.p2g - before.p2g,         ph.grid - before.grid,
+               ph.contact - before.contact, ph.g2p - before.g2p,
+               ph.constitutive - before.constitutive, ph.reorder - before.reorder,
+               ph.g2p_constitutive - before.g2p_constitutive};
   }
   return double(steps) * double(sim.particles().size()) / elapsed;
 }
@@ -122,7 +123,7 @@ int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps,
               rows.front().threads, rows.front().threads == 1 ? "" : "s");
   const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
   auto phases = [](const PhaseSeconds& ph) {
-    return std::array<double, 6>{ph.p2g,     ph.grid,      ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,
+    return std::array<double, 6>{ph.p2g,     ph.grid,   ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,
                                  ph.reorder, ph.total()};
   };
   std::printf("%7s %19s", "threads", "M particle-steps/s");
@@ -231,9 +232,9 @@ Command command_bench() {
           "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
           "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
-          "share of a step each phase takes (P2G with the grid's zeroing, grid update, body and wall contact, G2P with\n"
-          "the constitutive update (one pass), particle reorder); then quadratic NDPM on all cores at\n"
-          "dx 1.25 mm (16 times the points) for how the rate falls on larger beds; and\n"
+          "share of a step each phase takes (P2G, which zeroes the grid as it goes; grid update; body and\n"
+          "wall contact; G2P with the constitutive update, one pass; particle reorder); then quadratic\n"
+          "NDPM on all cores at dx 1.25 mm (16 times the points) for how the rate falls on larger beds; and\n"
           "stores them in FILE (default $FURROW_CALIBRATION, else $XDG_CONFIG_HOME/furrow/calibration.json,\n"
           "else ~/.config/furrow/calibration.json). `furrow validate` then prints a scene's predicted\n"
           "solver time, `furrow run` compares against it, and `furrow study` predicts its first rung.\n"

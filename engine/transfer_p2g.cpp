@@ -177,23 +177,20 @@ void Simulation::particles_to_grid() {
     const long last = k == pairs - 1 ? NX : std::clamp(long(W::width) * (2 * k + 1) - 1 + Grid::kPad, first, NX);
     std::fill(grid + first * NY, grid + last * NY, GridNode{});
   };
+  // both colours of strips, each strip scattered by `scatter`
+  auto in_colours = [&](const auto& scatter) {
+    for (int colour = 0; colour < 2; ++colour)
+      tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) {
+        if (colour == 0) zero_tile(k);
+        scatter(2 * k + colour);
+      });
+  };
 #if defined(__AVX__)
   if constexpr (std::is_same_v<K, QuadraticKernel> && Flip) {
-    if (by_four_) {
-      for (int colour = 0; colour < 2; ++colour)
-        tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) {
-          if (colour == 0) zero_tile(k);
-          p2g_strip_quadratic_by_four(2 * k + colour);
-        });
-      return;
-    }
+    if (by_four_) return in_colours([&](int strip) { p2g_strip_quadratic_by_four(strip); });
   }
 #endif
-  for (int colour = 0; colour < 2; ++colour)
-    tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) {
-      if (colour == 0) zero_tile(k);
-      scatter_strip(2 * k + colour);
-    });
+  in_colours(scatter_strip);
 }
 
 // The default P2G (quadratic B-splines, FLIP) of one strip, four points at a time: a point per
