@@ -4,7 +4,6 @@
 #include <Eigen/Dense>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -199,23 +198,24 @@ void Simulation::weigh_rim(size_t b) {
 }
 
 // The walls and the bodies act on the same nodes only where a body's node box reaches a boundary
-// line; elsewhere the walls (a few thousand nodes, serial) run beside the body contact, so on
-// two threads one thread starts the walls while the other starts the body's bands. Node and cell_fraction
+// line. Elsewhere the walls (a few thousand nodes) act in the grid update, each column of nodes as
+// it is updated (in cache, in parallel), before the bodies act on theirs. Node and cell_fraction
 // contact touch only their box's nodes; particle contact scatters a cell or more beyond it, so it
-// keeps the order bodies, then walls.
-void Simulation::bodies_and_walls() {
-  if (bodies_.empty()) return contact_walls();
-  bool apart = scene_.solver.contact != ContactMethod::Particle;
+// keeps the order bodies, then walls. Either way a node meets the same walls in the same order,
+// and the walls' forces are summed in the same order: the same bits.
+bool Simulation::walls_apart_from_bodies() const {
+  if (bodies_.empty()) return true;
+  if (scene_.solver.contact == ContactMethod::Particle) return false;
   for (const BodyState& s : bodies_) {
     const auto [i0, i1, j0, j1] = body_node_box(s, g_);
-    apart = apart && i0 > 0 && i1 < g_.nx && j0 > 0 && j1 < g_.ny;
+    if (i0 <= 0 || i1 >= g_.nx || j0 <= 0 || j1 >= g_.ny) return false;
   }
-  if (apart) {
-    tbb::parallel_invoke([&] { (this->*contact_)(); }, [&] { contact_walls(); });
-  } else {
-    (this->*contact_)();
-    contact_walls();
-  }
+  return true;
+}
+
+void Simulation::bodies_and_walls(bool walls_done) {
+  if (!bodies_.empty()) (this->*contact_)();
+  if (!walls_done) contact_walls();
 }
 
 // Node contact: every grid node inside a body takes the body's normal velocity (Coulomb slip
@@ -475,35 +475,52 @@ void Simulation::contact_cell_fraction() {
 }
 
 // Domain walls act on the nodes on and beyond each boundary line (walls lie on node lines, so
-// node contact is exact for them).
-void Simulation::contact_walls() {
-  const double dt = dt_s_;
-  const bool wall_friction = scene_.effects.wall_friction;
-  auto wall = [&](const Wall& w, int side, int i0, int i1, int j0, int j1, Vec2 n) {
-    Vec2 impulse(0.0, 0.0);
-    if (w.kind != Wall::Kind::Open)
-      for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) {
-          GridNode& node = g_.node[g_.index(i, j)];
-          if (node.m <= 0.0) continue;
-          Vec2 v(node.vx, node.vy);
-          const Vec2 before = v;
-          if (w.kind == Wall::Kind::Sticky)
-            v.setZero();
-          else
-            contact(v, Vec2(0.0, 0.0), n,
-                    w.kind == Wall::Kind::Friction && wall_friction ? w.friction : 0.0);
-          impulse += node.m * (v - before);
-          node.vx = v.x();
-          node.vy = v.y();
-        }
-    wall_forces_[side] = -impulse / dt;
-  };
+// node contact is exact for them): left, right, bottom, top, in that order at a corner node.
+// wall_impulse_[c] holds what each wall gave column c, summed up the column.
+void Simulation::walls_on_column(int i, std::array<Vec2, 4>& impulse) {
   const int P = Grid::kPad, nx = g_.nx, ny = g_.ny;
-  wall(scene_.walls.left, 0, -P, 0, -P, ny + P, Vec2(1, 0));
-  wall(scene_.walls.right, 1, nx, nx + P, -P, ny + P, Vec2(-1, 0));
-  wall(scene_.walls.bottom, 2, -P, nx + P, -P, 0, Vec2(0, 1));
-  wall(scene_.walls.top, 3, -P, nx + P, ny, ny + P, Vec2(0, -1));
+  const bool wall_friction = scene_.effects.wall_friction;
+  GridNode* const column = g_.node.data() + g_.index(i, -P);
+  auto wall = [&](const Wall& w, int side, int j0, int j1, const Vec2& n) {
+    Vec2 sum(0.0, 0.0);
+    if (w.kind != Wall::Kind::Open)
+      for (int j = j0; j <= j1; ++j) {
+        GridNode& node = column[j + P];
+        if (node.m <= 0.0) continue;
+        Vec2 v(node.vx, node.vy);
+        const Vec2 before = v;
+        if (w.kind == Wall::Kind::Sticky)
+          v.setZero();
+        else
+          contact(v, Vec2(0.0, 0.0), n, w.kind == Wall::Kind::Friction && wall_friction ? w.friction : 0.0);
+        sum += node.m * (v - before);
+        node.vx = v.x();
+        node.vy = v.y();
+      }
+    impulse[size_t(side)] = sum;
+  };
+  const Vec2 zero(0.0, 0.0);
+  if (i <= 0) wall(scene_.walls.left, 0, -P, ny + P, Vec2(1, 0));
+  else impulse[0] = zero;
+  if (i >= nx) wall(scene_.walls.right, 1, -P, ny + P, Vec2(-1, 0));
+  else impulse[1] = zero;
+  wall(scene_.walls.bottom, 2, -P, 0, Vec2(0, 1));
+  wall(scene_.walls.top, 3, ny, ny + P, Vec2(0, -1));
+}
+
+// The walls' forces on the media from the columns' impulses, column by column
+void Simulation::sum_wall_impulses() {
+  std::array<Vec2, 4> sum{Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero()};
+  for (const auto& column : wall_impulse_)
+    for (size_t side = 0; side < 4; ++side) sum[side] += column[side];
+  for (size_t side = 0; side < 4; ++side) wall_forces_[side] = -sum[side] / dt_s_;
+}
+
+// The walls after the bodies (a body reaches a boundary line, or particle contact).
+void Simulation::contact_walls() {
+  wall_impulse_.resize(size_t(g_.NX));
+  for (int c = 0; c < g_.NX; ++c) walls_on_column(c - Grid::kPad, wall_impulse_[size_t(c)]);
+  sum_wall_impulses();
 }
 
 // Friction of the front and back walls of a quasi-2D channel (scene walls.front_back): a point

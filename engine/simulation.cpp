@@ -212,9 +212,10 @@ void Simulation::step() {
   arena_->execute([&] {
     (this->*p2g_)();  // zeroes the grid as it scatters
     lap(phase_s_.p2g);
-    grid_update();
+    const bool walls_first = walls_apart_from_bodies();
+    grid_update(walls_first);  // and the walls, when no body reaches them
     lap(phase_s_.grid);
-    bodies_and_walls();
+    bodies_and_walls(walls_first);
     lap(phase_s_.contact);
     const bool front_back = scene_.walls.front_back.present() && scene_.effects.wall_friction;
     if (fuse_particle_passes_ && !front_back) {
@@ -254,28 +255,37 @@ double Simulation::lead_body_travel_m() const {
   return b < 0 ? 0.0 : (bodies_[size_t(b)].position_m - scene_.bodies[size_t(b)].start_m).norm();
 }
 
-void Simulation::grid_update() {
+// Momentum to velocity and gravity, column by column; with `walls`, each column's wall nodes are
+// held as soon as the column is done (contact_walls).
+void Simulation::grid_update(bool walls) {
   const double dt = dt_s_, gx = gravity_.x() * dt, gy = gravity_.y() * dt;
   const bool flip = flip_;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, g_.node.size(), kGridGrain), [&](const auto& r) {
-    for (size_t k = r.begin(); k < r.end(); ++k) {
-      GridNode& n = g_.node[k];
-      if (n.m > 0.0) {
-        const double inv_m = 1.0 / n.m;
-        if (flip) {
-          // vx0 held the force impulse; it becomes the pre-force velocity
-          const double v0x = n.vx * inv_m, v0y = n.vy * inv_m;
-          n.vx = v0x + n.vx0 * inv_m + gx;
-          n.vy = v0y + n.vy0 * inv_m + gy;
-          n.vx0 = v0x;
-          n.vy0 = v0y;
-        } else {
-          n.vx = n.vx * inv_m + gx;
-          n.vy = n.vy * inv_m + gy;
+  const size_t NY = size_t(g_.NY);
+  if (walls) wall_impulse_.resize(size_t(g_.NX));
+  tbb::parallel_for(tbb::blocked_range<int>(0, g_.NX, int(std::max<size_t>(1, kGridGrain / NY))), [&](const auto& r) {
+    for (int c = r.begin(); c < r.end(); ++c) {
+      GridNode* const column = g_.node.data() + size_t(c) * NY;
+      for (size_t k = 0; k < NY; ++k) {
+        GridNode& n = column[k];
+        if (n.m > 0.0) {
+          const double inv_m = 1.0 / n.m;
+          if (flip) {
+            // vx0 held the force impulse; it becomes the pre-force velocity
+            const double v0x = n.vx * inv_m, v0y = n.vy * inv_m;
+            n.vx = v0x + n.vx0 * inv_m + gx;
+            n.vy = v0y + n.vy0 * inv_m + gy;
+            n.vx0 = v0x;
+            n.vy0 = v0y;
+          } else {
+            n.vx = n.vx * inv_m + gx;
+            n.vy = n.vy * inv_m + gy;
+          }
         }
       }
+      if (walls) walls_on_column(c - Grid::kPad, wall_impulse_[size_t(c)]);
     }
   });
+  if (walls) sum_wall_impulses();
 }
 
 // G2P and the constitutive update. Fused, each block of particles gets both while it is in cache

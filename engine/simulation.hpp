@@ -1,5 +1,6 @@
 // Explicit plane-strain MPM over an immutable Scene. One step reads like the algorithm:
-//   particles_to_grid (zeroing the grid as it goes) -> grid_update -> bodies_and_walls
+//   particles_to_grid (zeroing the grid as it goes) -> grid_update (with the walls no body
+//   reaches) -> bodies_and_walls
 //   -> grid_to_particles -> constitutive_update -> advance_bodies
 // Particles and grid are structures of arrays; the shape-function kernel and the material law are
 // chosen once per scene (templates), so the hot loops carry no per-particle feature branches.
@@ -218,8 +219,9 @@ class Simulation {
   void sample_body_fields();
   void weigh_rim(size_t b);
   template <class Kernel, bool Flip> void particles_to_grid();
-  void grid_update();
-  void bodies_and_walls();
+  void grid_update(bool walls);
+  bool walls_apart_from_bodies() const;
+  void bodies_and_walls(bool walls_done);
   template <class Kernel> void contact_particles();
   template <class Kernel> void find_contact_points();
   template <class Kernel> void solve_contact_points();
@@ -227,6 +229,8 @@ class Simulation {
   template <bool Fraction> void contact_nodes();
   template <class Kernel> void contact_cell_fraction();
   void contact_walls();
+  void walls_on_column(int i, std::array<Vec2, 4>& impulse);
+  void sum_wall_impulses();
   void front_back_friction();
   struct G2PLocal {
     int64_t projected = 0;
@@ -254,6 +258,7 @@ class Simulation {
   Grid g_;
   std::vector<BodyState> bodies_;
   std::array<Vec2, 4> wall_forces_{Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero()};  // Eigen does not zero on {}
+  std::vector<std::array<Vec2, 4>> wall_impulse_;  // per node column: what each wall gave it this step
   std::vector<MaterialParams> materials_;
   double t_s_ = 0.0, dt_s_ = 0.0, wave_speed_ = 0.0;
   int64_t steps_ = 0;
