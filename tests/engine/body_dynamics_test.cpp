@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "engine/bodies.hpp"
@@ -69,6 +71,28 @@ TEST(BodyDynamics, FreeBodyFarFromTheMediaFallsAtG) {
   EXPECT_EQ(body.velocity_m_s.x(), 0.0);
   EXPECT_EQ(body.omega_rad_s, 0.0);
   EXPECT_NEAR(body.force_N_per_m.norm(), 0.0, 1e-12);
+}
+
+// A free body that leaves the domain stops the run with an error naming it and the time: a disk
+// thrown up at 3 m/s from 60 mm below the top, with no media in reach, crosses the top when
+// 0.46 + 3 t - g t^2 / 2 = 0.52 m (t = 20.7 ms).
+TEST(BodyDynamics, FreeBodyLeavingTheDomainStopsTheRunNamingItAndTheTime) {
+  Scene s = test_scenes::bed_scene(0.2, 0.02, 0.5, 0.005, 0.1);
+  Body b = disk(0.01, Vec2(0.1, 0.45), Vec2(0.0, 3.0));
+  make_free(b, true, true, true, 7800.0);
+  s.bodies.push_back(b);
+  Simulation sim(s);
+  const double g = 9.81, t_exit = (3.0 - std::sqrt(9.0 - 4.0 * 0.5 * g * 0.06)) / g;
+  try {
+    while (!sim.finished()) sim.step();
+    FAIL() << "the run ended at t = " << sim.time_s() << " s with the body inside";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    const std::string at = "body 'disk' left the domain at t = ";
+    ASSERT_EQ(msg.rfind(at, 0), 0u) << msg;
+    const double t = std::stod(msg.substr(at.size()));
+    EXPECT_NEAR(t, t_exit, 2.0 * sim.last_dt_s()) << msg;
+  }
 }
 
 // An applied load ramped over load_ramp_s, in the air and without gravity: the velocity grows as

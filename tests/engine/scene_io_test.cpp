@@ -345,6 +345,16 @@ std::vector<BadCase> bad_cases() {
       {"end displacement without a moving body", plain("hydrostatic_bed"), {"solver.end_displacement_m=0.1"}, "/solver/end_displacement_m", "no body moves"},
       {"scene name with a slash", plain(P), {"name=\"a/b\""}, "/name", "name"},
       {"negative load ramp", plain("footing"), {"bodies.footing.load_ramp_s=-0.1"}, "/bodies/0/load_ramp_s", "seconds"},
+      // free degrees of freedom and what they need (the footing: y free, its mass from a density)
+      {"free DOF without a mass", with("footing", [](json& j) { j["bodies"][0].erase("density_kg_m3"); }), {}, "/bodies/0/mass_kg_per_m", "a positive mass"},
+      {"zero mass", with("footing", [](json& j) { j["bodies"][0].erase("density_kg_m3"), j["bodies"][0]["mass_kg_per_m"] = 0; }), {}, "/bodies/0/mass_kg_per_m", "> 0"},
+      {"negative density", plain("footing"), {"bodies.footing.density_kg_m3=-7800"}, "/bodies/0/density_kg_m3", "> 0"},
+      {"negative inertia", with("footing", [](json& j) { j["bodies"][0]["inertia_kg_m"] = -1e-4; }), {}, "/bodies/0/inertia_kg_m", "> 0"},
+      {"mass and density both", with("footing", [](json& j) { j["bodies"][0]["mass_kg_per_m"] = 5.0; }), {}, "/bodies/0/density_kg_m3", "not both"},
+      {"a DOF listed twice", with("footing", [](json& j) { j["bodies"][0]["free"] = {"y", "y"}; }), {}, "/bodies/0/free/1", "once"},
+      {"unknown DOF", with("footing", [](json& j) { j["bodies"][0]["free"] = {"z"}; }), {}, "/bodies/0/free/0", "\"angle\""},
+      {"mass on a prescribed body", with(P, [](json& j) { j["bodies"][0]["mass_kg_per_m"] = 5.0; }), {}, "/bodies/0/mass_kg_per_m", "prescribed"},
+      {"free body with particle contact", plain("footing"), {"solver.contact=\"particle\""}, "/bodies/0/free", "\"cell_fraction\""},
       {"load ramp on a prescribed body", plain(P), {"bodies.plate.load_ramp_s=0.1"}, "/bodies/0/load_ramp_s", "prescribed"},
   };
 }
