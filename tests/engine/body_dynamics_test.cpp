@@ -53,16 +53,22 @@ Scene template_scene(const std::string& name) {
   return load_scene((std::filesystem::path(FURROW_SOURCE_DIR) / "scenes" / (name + ".json")).string());
 }
 
+// A free steel disk (10 mm radius, every DOF free) over a thin bed in a tall box of air
+// (0.2 x 0.52 m, dx 5 mm, 0.1 s).
+Scene disk_in_the_air(Vec2 start_m, Vec2 velocity_m_s) {
+  Scene s = test_scenes::bed_scene(0.2, 0.02, 0.5, 0.005, 0.1);
+  Body b = disk(0.01, start_m, velocity_m_s);
+  make_free(b, true, true, true, 7800.0);
+  s.bodies.push_back(b);
+  return s;
+}
+
 }  // namespace
 
 // Far above the bed a free body only feels gravity: symplectic Euler gives v = -g t exactly and
 // y within g t dt of y0 - g t^2 / 2.
 TEST(BodyDynamics, FreeBodyFarFromTheMediaFallsAtG) {
-  Scene s = test_scenes::bed_scene(0.2, 0.02, 0.5, 0.005, 0.1);
-  Body b = disk(0.01, Vec2(0.1, 0.4), Vec2(0.0, 0.0));
-  make_free(b, true, true, true, 7800.0);
-  s.bodies.push_back(b);
-  Simulation sim(s);
+  Simulation sim(disk_in_the_air(Vec2(0.1, 0.4), Vec2(0.0, 0.0)));
   while (!sim.finished()) sim.step();
   const double g = 9.81, t = sim.time_s();
   const BodyState& body = sim.bodies()[0];
@@ -77,11 +83,7 @@ TEST(BodyDynamics, FreeBodyFarFromTheMediaFallsAtG) {
 // thrown up at 3 m/s from 60 mm below the top, with no media in reach, crosses the top when
 // 0.46 + 3 t - g t^2 / 2 = 0.52 m (t = 20.7 ms).
 TEST(BodyDynamics, FreeBodyLeavingTheDomainStopsTheRunNamingItAndTheTime) {
-  Scene s = test_scenes::bed_scene(0.2, 0.02, 0.5, 0.005, 0.1);
-  Body b = disk(0.01, Vec2(0.1, 0.45), Vec2(0.0, 3.0));
-  make_free(b, true, true, true, 7800.0);
-  s.bodies.push_back(b);
-  Simulation sim(s);
+  Simulation sim(disk_in_the_air(Vec2(0.1, 0.45), Vec2(0.0, 3.0)));
   const double g = 9.81, t_exit = (3.0 - std::sqrt(9.0 - 4.0 * 0.5 * g * 0.06)) / g;
   try {
     while (!sim.finished()) sim.step();
