@@ -298,180 +298,207 @@ void Simulation::contact_nodes() {
 // within kTouchCells of the body marks the nodes of its stencil, and a node stays marked while both
 // the media and the body's field reach it. Without this, the body's field acts on material up to
 // a cell from the surface and the body feels the bed before it meets it.
+//
+// It runs in three parts: this step's plan (serial: each body's node box, its bands, its field's
+// lattice weights), each band's sums (cell_fraction_band, in parallel), and the node pass
+// (contact_nodes<true>). Both sums run over bands of the box's nodes, across its longer side (a
+// sample or point whose stencil spans two bands is worked out in both, and fewer do so when the
+// bands are wide). Each band visits every sample and point in the same order as one pass would
+// and adds only to its own nodes, so each node's sum is the same whatever the bands: results are
+// the same for any thread count. One band per thread, each at least four nodes across; on one
+// thread, one band and no work twice. A band reads the grid only at its own nodes, so where the
+// bodies' boxes are apart each band updates its own nodes itself and its sums run in the grid
+// update's parallel region (grid_and_bands): the sums are tens of microseconds a step, and each
+// region pays a wake-up of the other threads. Returns whether the boxes are apart.
 template <class K>
-void Simulation::contact_cell_fraction() {
-  const double dx = g_.dx, inv_dx = 1.0 / dx;
-  // a point reaches the nodes of the body's box (the body's box and two cells) from 1.5 cells out
-  const double reach = 3.5 * dx;
-  const int strips = int(strip_start_.size()) - 1;
+bool Simulation::plan_cell_fraction() {
+  const double inv_dx = 1.0 / g_.dx;
   touched_.resize(bodies_.size());
   body_node_mass_kg_.resize(bodies_.size());
   stencil_dv_kg_m_s_.resize(bodies_.size());
   stencil_mass_kg_.resize(bodies_.size());
   stencil_nn_.resize(bodies_.size());
+  field_plans_.resize(bodies_.size());
+  band_tasks_.clear();
+  const int threads = tbb::this_task_arena::max_concurrency();
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const BodyState& s = bodies_[b];
-    const Shape& shape = scene_.bodies[b].shape;
-    const double mu = scene_.effects.body_friction ? scene_.bodies[b].friction : 0.0;
-    auto& touched = touched_[b];
-    touched.resize(g_.node.size(), 0);
+    FieldPlan& plan = field_plans_[b];
     // only nodes contact_nodes() visits are marked, so it also clears every mark it leaves behind
+    touched_[b].resize(g_.node.size(), 0);
     const auto [i0, i1, j0, j1] = body_node_box(s, g_);
-    const size_t width = size_t(i1 - i0 + 1), box_nodes = width * size_t(j1 - j0 + 1);
-    auto& dv = stencil_dv_kg_m_s_[b];
-    auto& m_points = stencil_mass_kg_[b];
-    dv.assign(box_nodes, Vec2(0.0, 0.0));
-    m_points.assign(box_nodes, 0.0);
-    const bool free = scene_.bodies[b].dynamics.any_free();
-    if (free) stencil_nn_[b].assign(box_nodes, Vec3(0.0, 0.0, 0.0));
-    // Both sums below run over bands of the box's nodes in parallel, across its longer side (a
-    // sample or point whose stencil spans two bands is worked out in both, and fewer do so when the
-    // bands are wide). Each band visits every sample and point in the same order as one pass would
-    // and adds only to its own nodes, so each node's sum is the same whatever the bands: results
-    // are the same for any thread count. One band per thread, each at least four nodes across; on
-    // one thread, one band and no work twice. Both sums run in one parallel region (a band works
-    // out the field N - 1 nodes beyond its own too, where its points' stencils reach): the phase is
-    // tens of microseconds a step, and each region pays a wake-up of the other threads.
+    plan.i0 = i0, plan.i1 = i1, plan.j0 = j0, plan.j1 = j1;
+    const size_t box_nodes = size_t(i1 - i0 + 1) * size_t(j1 - j0 + 1);
+    stencil_dv_kg_m_s_[b].assign(box_nodes, Vec2(0.0, 0.0));
+    stencil_mass_kg_[b].assign(box_nodes, 0.0);
+    if (scene_.bodies[b].dynamics.any_free()) stencil_nn_[b].assign(box_nodes, Vec3(0.0, 0.0, 0.0));
+    body_node_mass_kg_[b].assign(box_nodes, 0.0);
     const bool by_columns = i1 - i0 > j1 - j0;
     const int across = by_columns ? i1 - i0 + 1 : j1 - j0 + 1, first_line = by_columns ? i0 : j0;
-    const int threads = tbb::this_task_arena::max_concurrency();
-    const int bands = threads == 1 ? 1 : std::clamp(std::min(across / 4, threads), 1, across);
-    struct Band {
-      int i0, i1, j0, j1;  // the nodes it adds to
-    };
-    auto band_nodes = [&](int band) {
-      const int a = first_line + int(int64_t(across) * band / bands);
-      const int z = first_line + int(int64_t(across) * (band + 1) / bands) - 1;
-      return by_columns ? Band{a, z, j0, j1} : Band{i0, i1, a, z};
-    };
-    // the body's field over its node box; with several bands each adds up its own copy
-    auto& field = body_node_mass_kg_[b];
-    field.assign(box_nodes, 0.0);
-    if (bands > 1) band_field_.resize(size_t(bands));
-    const BodySamples& samples = body_samples_[b];
-    auto add_sample = [&](double* out, const Band& n, int bx, int by, const double* wx, const double* wy, double m) {
-      if (by >= n.j0 && by + K::N - 1 <= n.j1 && bx >= n.i0 && bx + K::N - 1 <= n.i1) {
-        // the whole stencil in the band (most samples): fixed trip counts, the same sums
-        double* const row0 = out + size_t(by - j0) * width + size_t(bx - i0);
-        for (int j = 0; j < K::N; ++j)
-          for (int i = 0; i < K::N; ++i) row0[size_t(j) * width + size_t(i)] += wx[i] * wy[j] * m;
-        return;
-      }
-      if (by > n.j1 || by + K::N - 1 < n.j0 || bx > n.i1 || bx + K::N - 1 < n.i0) return;
-      for (int j = std::max(by, n.j0); j <= std::min(by + K::N - 1, n.j1); ++j)
-        for (int i = std::max(bx, n.i0); i <= std::min(bx + K::N - 1, n.i1); ++i)
-          out[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * m;
-    };
-    // a body that never turns keeps its samples' lattice on the grid's axes: the weights of a
-    // lattice column (row) are those of each of its samples, worked out once. The samples lie in
-    // rows from the bottom, each row by column, and the bases ascend with the column (row), so the
-    // samples whose stencil meets a band's nodes are a run of rows and, in each, a run of columns:
-    // a band walks only those, in the one pass's order
-    const size_t columns = s.turns ? 0 : samples.column_x_m.size(), rows = s.turns ? 0 : samples.row_y_m.size();
-    std::vector<int> column_base(columns), row_base(rows);
-    std::vector<double> column_w(columns * K::N), row_w(rows * K::N);
-    {
-      double dw[K::N];
-      for (size_t a = 0; a < columns; ++a)
-        column_base[a] = K::weights((s.position_m.x() + samples.column_x_m[a]) * inv_dx, &column_w[a * K::N], dw, inv_dx);
-      for (size_t a = 0; a < rows; ++a)
-        row_base[a] = K::weights((s.position_m.y() + samples.row_y_m[a]) * inv_dx, &row_w[a * K::N], dw, inv_dx);
+    plan.bands = threads == 1 ? 1 : std::clamp(std::min(across / 4, threads), 1, across);
+    plan.first_task = band_tasks_.size();
+    for (int band = 0; band < plan.bands; ++band) {
+      const int a = first_line + int(int64_t(across) * band / plan.bands);
+      const int z = first_line + int(int64_t(across) * (band + 1) / plan.bands) - 1;
+      band_tasks_.push_back(by_columns ? BandTask{b, a, z, j0, j1} : BandTask{b, i0, i1, a, z});
     }
+    // a body that never turns keeps its samples' lattice on the grid's axes: the weights of a
+    // lattice column (row) are those of each of its samples, worked out once
+    const BodySamples& samples = body_samples_[b];
+    const size_t columns = s.turns ? 0 : samples.column_x_m.size(), rows = s.turns ? 0 : samples.row_y_m.size();
+    plan.column_base.resize(columns), plan.row_base.resize(rows);
+    plan.column_w.resize(columns * K::N), plan.row_w.resize(rows * K::N);
+    double dw[K::N];
+    for (size_t a = 0; a < columns; ++a)
+      plan.column_base[a] = K::weights((s.position_m.x() + samples.column_x_m[a]) * inv_dx, &plan.column_w[a * K::N], dw, inv_dx);
+    for (size_t a = 0; a < rows; ++a)
+      plan.row_base[a] = K::weights((s.position_m.y() + samples.row_y_m[a]) * inv_dx, &plan.row_w[a * K::N], dw, inv_dx);
     if (s.turns) weigh_rim(b);
-    auto add_field = [&](double* out, const Band& n) {
-      if (s.turns) {
-        for (size_t k = 0; k < samples.q_m.size(); ++k) {
-          const Vec2 x = s.position_m + s.to_world(samples.q_m[k]);
-          double wx[K::N], wy[K::N], dw[K::N];
-          const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
-          const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
-          add_sample(out, n, bx, by, wx, wy, samples.weight.empty() ? body_sample_mass_kg_ : samples.weight[k] * body_sample_mass_kg_);
-        }
-        return;
-      }
-      // lattice lines whose stencil (base .. base + N - 1) meets the band's lo .. hi
-      auto meeting = [](const std::vector<int>& base, int lo, int hi) {
-        return std::pair(uint32_t(std::lower_bound(base.begin(), base.end(), lo - (K::N - 1)) - base.begin()),
-                         uint32_t(std::upper_bound(base.begin(), base.end(), hi) - base.begin()));
-      };
-      const auto [a0, a1] = meeting(column_base, n.i0, n.i1);
-      const auto [c0, c1] = meeting(row_base, n.j0, n.j1);
-      const uint32_t* const column = samples.column.data();
-      for (uint32_t c = c0; c < c1; ++c) {
-        const uint32_t *const row_first = column + samples.row_start[c], *const row_end = column + samples.row_start[c + 1];
-        for (const uint32_t* k = std::lower_bound(row_first, row_end, a0); k < row_end && *k < a1; ++k)
-          add_sample(out, n, column_base[*k], row_base[c], &column_w[*k * K::N], &row_w[c * K::N], body_sample_mass_kg_);
-      }
-    };
-    // each point in reach: marks its stencil if it touches the body, and adds to each node of its
-    // stencil (weight x mass) the change that holds the node against the body along the point's
-    // own face normal; points in strip order. Only nodes the body's field reaches: contact_nodes()
-    // acts on no other (and clears their marks).
-    tbb::parallel_for(0, bands, [&](int band) {
-      const Band n = band_nodes(band);
-      const double* f = field.data();  // the field at the band's nodes and N - 1 beyond
-      if (bands == 1) {
-        add_field(field.data(), n);
-      } else {
-        std::vector<double>& own = band_field_[size_t(band)];
-        own.assign(box_nodes, 0.0);
-        const int m = K::N - 1;
-        add_field(own.data(), Band{std::max(n.i0 - m, i0), std::min(n.i1 + m, i1), std::max(n.j0 - m, j0), std::min(n.j1 + m, j1)});
-        for (int j = n.j0; j <= n.j1; ++j)
-          std::copy_n(own.data() + size_t(j - j0) * width + size_t(n.i0 - i0), n.i1 - n.i0 + 1,
-                      field.data() + size_t(j - j0) * width + size_t(n.i0 - i0));
-        f = own.data();
-      }
-      // a point whose stencil meets the band's nodes lies within (first - N, last + 3) cells of
-      // them on each axis (a kernel's base is at most two cells below the point), and in the body's
-      // reach: only the strips and rows that could hold such points are walked, in the order one
-      // walk would take
-      const Vec2 lo = s.position_m + s.lo_m - Vec2(reach, reach), hi = s.position_m + s.hi_m + Vec2(reach, reach);
-      const double x_lo = std::max(lo.x(), (n.i0 - K::N) * dx), x_hi = std::min(hi.x(), (n.i1 + 3) * dx);
-      const double y_lo = std::max(lo.y(), (n.j0 - K::N) * dx), y_hi = std::min(hi.y(), (n.j1 + 3) * dx);
-      if (x_lo > x_hi || y_lo > y_hi) return;
-      const auto [first, last] = strip_span<K>(x_lo, x_hi, inv_dx, strips);
-      for (int strip = first; strip <= last; ++strip) {
-        const auto [pa, pb] = strip_rows_span<K>(strip, y_lo, y_hi);
-        for (uint32_t p = pa; p < pb; ++p) {
-          const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
-          if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
-              r.y() > s.hi_m.y() + reach)
-            continue;
-          const int base_x = K::base(p_.x[p] * inv_dx), base_y = K::base(p_.y[p] * inv_dx);
-          if (base_y > n.j1 || base_y + K::N - 1 < n.j0 || base_x > n.i1 || base_x + K::N - 1 < n.i0) continue;
-          double wx[K::N], wy[K::N], dw[K::N];
-          const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
-          const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
-          const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
-          const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
-          bool reached = false;  // over the whole stencil, not only this band's nodes
-          for (int j = ja; j <= jb; ++j)
-            for (int i = ia; i <= ib; ++i) reached |= f[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
-          if (!reached) continue;
-          const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
-          const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
-          const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
-          const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
-          const double mass = double(p_.mass[p]);
-          for (int j = std::max(ja, n.j0); j <= std::min(jb, n.j1); ++j)
-            for (int i = std::max(ia, n.i0); i <= std::min(ib, n.i1); ++i) {
-              const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
-              if (f[c] <= 0.0) continue;
-              if (touching) touched[k] = 1;
-              const double wm = wx[i - bx] * wy[j - by] * mass;
-              m_points[c] += wm;
-              Vec2 v(g_.node[k].vx, g_.node[k].vy);
-              const Vec2 v0 = v;
-              if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
-              dv[c] += wm * (v - v0);
-              if (free) stencil_nn_[b][c] += wm * nn;
-            }
-        }
-      }
-    });
   }
-  contact_nodes<true>();
+  if (band_field_.size() < band_tasks_.size()) band_field_.resize(band_tasks_.size());
+  for (size_t a = 0; a < field_plans_.size(); ++a)
+    for (size_t b = a + 1; b < field_plans_.size(); ++b) {
+      const FieldPlan &p = field_plans_[a], &q = field_plans_[b];
+      if (p.i0 <= q.i1 && q.i0 <= p.i1 && p.j0 <= q.j1 && q.j0 <= p.j1) return false;
+    }
+  return true;
+}
+
+// One band's sums: the body's field over its nodes, then each point in reach, which marks its
+// stencil if it touches the body and adds to each node of its stencil (weight x mass) the change
+// that holds the node against the body along the point's own face normal; points in strip order.
+// Only nodes the body's field reaches: contact_nodes() acts on no other (and clears their marks).
+// With `update_nodes` the band first does the grid update of its own nodes (grid_and_bands).
+template <class K>
+void Simulation::cell_fraction_band(size_t task, bool update_nodes) {
+  const BandTask& n = band_tasks_[task];
+  const size_t b = n.body;
+  const FieldPlan& plan = field_plans_[b];
+  if (update_nodes) {
+    const double gx = gravity_.x() * dt_s_, gy = gravity_.y() * dt_s_;
+    for (int i = n.i0; i <= n.i1; ++i) {
+      GridNode* const first = g_.node.data() + g_.index(i, n.j0);
+      furrow::update_nodes(first, first + (n.j1 - n.j0 + 1), gx, gy, flip_);
+    }
+  }
+  const double dx = g_.dx, inv_dx = 1.0 / dx;
+  // a point reaches the nodes of the body's box (the body's box and two cells) from 1.5 cells out
+  const double reach = 3.5 * dx;
+  const int strips = int(strip_start_.size()) - 1;
+  const BodyState& s = bodies_[b];
+  const Shape& shape = scene_.bodies[b].shape;
+  const double mu = scene_.effects.body_friction ? scene_.bodies[b].friction : 0.0;
+  const bool free = scene_.bodies[b].dynamics.any_free();
+  auto& touched = touched_[b];
+  auto& dv = stencil_dv_kg_m_s_[b];
+  auto& m_points = stencil_mass_kg_[b];
+  const int i0 = plan.i0, i1 = plan.i1, j0 = plan.j0, j1 = plan.j1;
+  const size_t width = size_t(i1 - i0 + 1), box_nodes = width * size_t(j1 - j0 + 1);
+  const BodySamples& samples = body_samples_[b];
+  auto add_sample = [&](double* out, const BandTask& r, int bx, int by, const double* wx, const double* wy, double m) {
+    if (by >= r.j0 && by + K::N - 1 <= r.j1 && bx >= r.i0 && bx + K::N - 1 <= r.i1) {
+      // the whole stencil in the band (most samples): fixed trip counts, the same sums
+      double* const row0 = out + size_t(by - j0) * width + size_t(bx - i0);
+      for (int j = 0; j < K::N; ++j)
+        for (int i = 0; i < K::N; ++i) row0[size_t(j) * width + size_t(i)] += wx[i] * wy[j] * m;
+      return;
+    }
+    if (by > r.j1 || by + K::N - 1 < r.j0 || bx > r.i1 || bx + K::N - 1 < r.i0) return;
+    for (int j = std::max(by, r.j0); j <= std::min(by + K::N - 1, r.j1); ++j)
+      for (int i = std::max(bx, r.i0); i <= std::min(bx + K::N - 1, r.i1); ++i)
+        out[size_t(j - j0) * width + size_t(i - i0)] += wx[i - bx] * wy[j - by] * m;
+  };
+  // the samples lie in rows from the bottom, each row by column, and the lattice weights' bases
+  // ascend with the column (row), so the samples whose stencil meets a band's nodes are a run of
+  // rows and, in each, a run of columns: a band walks only those, in the one pass's order
+  auto add_field = [&](double* out, const BandTask& r) {
+    if (s.turns) {
+      for (size_t k = 0; k < samples.q_m.size(); ++k) {
+        const Vec2 x = s.position_m + s.to_world(samples.q_m[k]);
+        double wx[K::N], wy[K::N], dw[K::N];
+        const int bx = K::weights(x.x() * inv_dx, wx, dw, inv_dx);
+        const int by = K::weights(x.y() * inv_dx, wy, dw, inv_dx);
+        add_sample(out, r, bx, by, wx, wy, samples.weight.empty() ? body_sample_mass_kg_ : samples.weight[k] * body_sample_mass_kg_);
+      }
+      return;
+    }
+    // lattice lines whose stencil (base .. base + N - 1) meets the band's lo .. hi
+    auto meeting = [](const std::vector<int>& base, int lo, int hi) {
+      return std::pair(uint32_t(std::lower_bound(base.begin(), base.end(), lo - (K::N - 1)) - base.begin()),
+                       uint32_t(std::upper_bound(base.begin(), base.end(), hi) - base.begin()));
+    };
+    const auto [a0, a1] = meeting(plan.column_base, r.i0, r.i1);
+    const auto [c0, c1] = meeting(plan.row_base, r.j0, r.j1);
+    const uint32_t* const column = samples.column.data();
+    for (uint32_t c = c0; c < c1; ++c) {
+      const uint32_t *const row_first = column + samples.row_start[c], *const row_end = column + samples.row_start[c + 1];
+      for (const uint32_t* k = std::lower_bound(row_first, row_end, a0); k < row_end && *k < a1; ++k)
+        add_sample(out, r, plan.column_base[*k], plan.row_base[c], &plan.column_w[*k * K::N], &plan.row_w[c * K::N],
+                   body_sample_mass_kg_);
+    }
+  };
+  // the body's field over its node box; with several bands each adds up its own copy over its
+  // nodes and N - 1 beyond (where its points' stencils reach) and writes its own nodes
+  auto& field = body_node_mass_kg_[b];
+  const double* f = field.data();
+  if (plan.bands == 1) {
+    add_field(field.data(), n);
+  } else {
+    std::vector<double>& own = band_field_[task];
+    own.assign(box_nodes, 0.0);
+    const int m = K::N - 1;
+    add_field(own.data(), BandTask{b, std::max(n.i0 - m, i0), std::min(n.i1 + m, i1), std::max(n.j0 - m, j0), std::min(n.j1 + m, j1)});
+    for (int j = n.j0; j <= n.j1; ++j)
+      std::copy_n(own.data() + size_t(j - j0) * width + size_t(n.i0 - i0), n.i1 - n.i0 + 1,
+                  field.data() + size_t(j - j0) * width + size_t(n.i0 - i0));
+    f = own.data();
+  }
+  // a point whose stencil meets the band's nodes has its base within n.i0 - N + 1 .. n.i1 (and
+  // n.j0 - N + 1 .. n.j1), and lies in the body's reach: only the strips and rows that could hold
+  // such points are walked, in the order one walk would take
+  const Vec2 lo = s.position_m + s.lo_m - Vec2(reach, reach), hi = s.position_m + s.hi_m + Vec2(reach, reach);
+  const int bx_lo = std::max(K::base(lo.x() * inv_dx), n.i0 - K::N + 1), bx_hi = std::min(K::base(hi.x() * inv_dx), n.i1);
+  const int by_lo = std::max(K::base(lo.y() * inv_dx), n.j0 - K::N + 1), by_hi = std::min(K::base(hi.y() * inv_dx), n.j1);
+  if (bx_lo > bx_hi || by_lo > by_hi) return;
+  const auto [first, last] = strips_of_bases<K>(bx_lo, bx_hi, strips);
+  for (int strip = first; strip <= last; ++strip) {
+    const auto [pa, pb] = strip_rows_of_bases(strip, by_lo, by_hi);
+    for (uint32_t p = pa; p < pb; ++p) {
+      const Vec2 r = Vec2(p_.x[p], p_.y[p]) - s.position_m;
+      if (r.x() < s.lo_m.x() - reach || r.y() < s.lo_m.y() - reach || r.x() > s.hi_m.x() + reach ||
+          r.y() > s.hi_m.y() + reach)
+        continue;
+      const int base_x = K::base(p_.x[p] * inv_dx), base_y = K::base(p_.y[p] * inv_dx);
+      if (base_y > n.j1 || base_y + K::N - 1 < n.j0 || base_x > n.i1 || base_x + K::N - 1 < n.i0) continue;
+      double wx[K::N], wy[K::N], dw[K::N];
+      const int bx = K::weights(p_.x[p] * inv_dx, wx, dw, inv_dx);
+      const int by = K::weights(p_.y[p] * inv_dx, wy, dw, inv_dx);
+      const int ja = std::max(by, j0), jb = std::min(by + K::N - 1, j1);
+      const int ia = std::max(bx, i0), ib = std::min(bx + K::N - 1, i1);
+      bool reached = false;  // over the whole stencil, not only this band's nodes
+      for (int j = ja; j <= jb; ++j)
+        for (int i = ia; i <= ib; ++i) reached |= f[size_t(j - j0) * width + size_t(i - i0)] > 0.0;
+      if (!reached) continue;
+      const Vec2 q = s.to_body(Vec2(p_.x[p], p_.y[p]));
+      const bool touching = shape_sdf(shape, q) - 0.5 * std::sqrt(p_.volume[p]) <= kTouchCells * dx;
+      const Vec2 normal = s.to_world(shape_normal(shape, q, 1e-4 * dx));
+      const Vec3 nn(normal.x() * normal.x(), normal.x() * normal.y(), normal.y() * normal.y());
+      const double mass = double(p_.mass[p]);
+      for (int j = std::max(ja, n.j0); j <= std::min(jb, n.j1); ++j)
+        for (int i = std::max(ia, n.i0); i <= std::min(ib, n.i1); ++i) {
+          const size_t k = g_.index(i, j), c = size_t(j - j0) * width + size_t(i - i0);
+          if (f[c] <= 0.0) continue;
+          if (touching) touched[k] = 1;
+          const double wm = wx[i - bx] * wy[j - by] * mass;
+          m_points[c] += wm;
+          Vec2 v(g_.node[k].vx, g_.node[k].vy);
+          const Vec2 v0 = v;
+          if (!contact(v, s.velocity_at(Vec2(i * dx, j * dx)), normal, mu)) continue;
+          dv[c] += wm * (v - v0);
+          if (free) stencil_nn_[b][c] += wm * nn;
+        }
+    }
+  }
 }
 
 // Domain walls act on the nodes on and beyond each boundary line (walls lie on node lines, so
@@ -620,8 +647,12 @@ void Simulation::respond_free_body(size_t b, Vec2& impulse, double& angular) {
 
 // the instances Simulation's constructor picks from
 template void Simulation::contact_nodes<false>();
-template void Simulation::contact_cell_fraction<LinearKernel>();
-template void Simulation::contact_cell_fraction<QuadraticKernel>();
-template void Simulation::contact_cell_fraction<CubicKernel>();
+template void Simulation::contact_nodes<true>();
+template bool Simulation::plan_cell_fraction<LinearKernel>();
+template bool Simulation::plan_cell_fraction<QuadraticKernel>();
+template bool Simulation::plan_cell_fraction<CubicKernel>();
+template void Simulation::cell_fraction_band<LinearKernel>(size_t, bool);
+template void Simulation::cell_fraction_band<QuadraticKernel>(size_t, bool);
+template void Simulation::cell_fraction_band<CubicKernel>(size_t, bool);
 
 }  // namespace furrow

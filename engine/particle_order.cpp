@@ -81,12 +81,22 @@ void Simulation::reorder_particles() {
 // for round-off). A superset: callers keep their own test.
 template <class K>
 std::pair<uint32_t, uint32_t> Simulation::strip_rows_span(int strip, double y_lo_m, double y_hi_m) const {
+  const double inv = 1.0 / g_.dx;
+  return strip_rows(strip, K::base((y_lo_m - drift_y_m_) * inv) - 1, K::base((y_hi_m + drift_y_m_) * inv) + 1);
+}
+
+// The same for the points whose stencil now starts at node rows base_lo .. base_hi: a point that
+// moved at most drift_y_m_ had its base within ceil(drift / dx) rows of its base now.
+std::pair<uint32_t, uint32_t> Simulation::strip_rows_of_bases(int strip, int base_lo, int base_hi) const {
+  const int rows = int(std::ceil(drift_y_m_ / g_.dx)) + 1;
+  return strip_rows(strip, base_lo - rows, base_hi + rows);
+}
+
+// The points of `strip` sorted into stencil rows base_lo .. base_hi at the reorder.
+std::pair<uint32_t, uint32_t> Simulation::strip_rows(int strip, int base_lo, int base_hi) const {
   // resumed from a checkpoint without rows: the whole strip until the next reorder
   if (strip_row_start_.empty()) return {strip_start_[size_t(strip)], strip_start_[size_t(strip) + 1]};
-  const double inv = 1.0 / g_.dx;
-  auto row = [&](double y) { return std::clamp(K::base(y * inv) + Grid::kPad, 0, strip_rows_ - 1); };
-  const int r0 = std::max(row(y_lo_m - drift_y_m_) - 1, 0);
-  const int r1 = std::min(row(y_hi_m + drift_y_m_) + 1, strip_rows_ - 1);
+  const int r0 = std::clamp(base_lo + Grid::kPad, 0, strip_rows_ - 1), r1 = std::clamp(base_hi + Grid::kPad, 0, strip_rows_ - 1);
   const size_t at = size_t(strip) * size_t(strip_rows_);
   return {strip_row_start_[at + size_t(r0)], strip_row_start_[at + size_t(r1) + 1]};
 }

@@ -90,7 +90,11 @@ Simulation::Simulation(const Scene& scene) : scene_(scene) {
     switch (scene_.solver.contact) {
       case ContactMethod::Node: contact_ = &Simulation::contact_nodes<false>; break;
       case ContactMethod::Particle: contact_ = &Simulation::contact_particles<K>; break;
-      case ContactMethod::CellFraction: contact_ = &Simulation::contact_cell_fraction<K>; break;
+      case ContactMethod::CellFraction:
+        contact_ = &Simulation::contact_nodes<true>;
+        plan_bands_ = &Simulation::plan_cell_fraction<K>;
+        band_sums_ = &Simulation::cell_fraction_band<K>;
+        break;
     }
     g2p_range_ = flip_ ? &Simulation::g2p_range<K, true> : &Simulation::g2p_range<K, false>;
     reorder_ = &Simulation::reorder_particles<K>;
@@ -212,9 +216,18 @@ void Simulation::step() {
   arena_->execute([&] {
     (this->*p2g_)();  // zeroes the grid as it scatters
     lap(phase_s_.p2g);
-    const bool walls_first = walls_apart_from_bodies();
-    grid_update(walls_first);  // and the walls, when no body reaches them
-    lap(phase_s_.grid);
+    const bool walls_first = walls_apart_from_bodies();  // then the walls act in the grid update
+    if (plan_bands_ && !bodies_.empty()) {
+      // cell_fraction's band sums in the grid update's region where the bodies' boxes are apart
+      const bool apart = (this->*plan_bands_)();
+      lap(phase_s_.contact);
+      grid_and_bands(walls_first, true, apart);
+      lap(phase_s_.grid);
+      if (!apart) grid_and_bands(false, false, true);
+    } else {
+      grid_and_bands(walls_first, true, false);
+      lap(phase_s_.grid);
+    }
     bodies_and_walls(walls_first);
     lap(phase_s_.contact);
     const bool front_back = scene_.walls.front_back.present() && scene_.effects.wall_friction;
@@ -255,37 +268,53 @@ double Simulation::lead_body_travel_m() const {
   return b < 0 ? 0.0 : (bodies_[size_t(b)].position_m - scene_.bodies[size_t(b)].start_m).norm();
 }
 
-// Momentum to velocity and gravity, column by column; with `walls`, each column's wall nodes are
-// held as soon as the column is done (contact_walls).
-void Simulation::grid_update(bool walls) {
-  const double dt = dt_s_, gx = gravity_.x() * dt, gy = gravity_.y() * dt;
+// One parallel region: with `grid`, the grid update (momentum to velocity and gravity), column by
+// column, each column's wall nodes held as soon as it is done when `walls` (contact_walls); with
+// `bands`, cell_fraction's bands (cell_fraction_band), which with `grid` update their own nodes
+// first while the columns' tasks skip them. A node's update is its own, so the bits are the same
+// whichever task does it.
+void Simulation::grid_and_bands(bool walls, bool grid, bool bands) {
+  const double gx = gravity_.x() * dt_s_, gy = gravity_.y() * dt_s_;
   const bool flip = flip_;
   const size_t NY = size_t(g_.NY);
-  if (walls) wall_impulse_.resize(size_t(g_.NX));
-  tbb::parallel_for(tbb::blocked_range<int>(0, g_.NX, int(std::max<size_t>(1, kGridGrain / NY))), [&](const auto& r) {
-    for (int c = r.begin(); c < r.end(); ++c) {
+  const int per_task = int(std::max<size_t>(1, kGridGrain / NY));
+  const int band_tasks = bands ? int(band_tasks_.size()) : 0;
+  const int grid_tasks = grid ? (g_.NX + per_task - 1) / per_task : 0;
+  if (grid && walls) wall_impulse_.resize(size_t(g_.NX));
+  // the bodies' boxes (apart) from the bottom: the rows a column's task leaves to the bands
+  std::vector<const FieldPlan*> boxes;
+  if (grid && bands)
+    for (const FieldPlan& p : field_plans_) boxes.push_back(&p);
+  std::sort(boxes.begin(), boxes.end(), [](const FieldPlan* a, const FieldPlan* b) { return a->j0 < b->j0; });
+  // the bands spread evenly over the tasks (band k at task k n / bands): the range is split in
+  // halves, so each thread starts on a band and the columns' small tasks even out the rest
+  const int tasks = band_tasks + grid_tasks;
+  constexpr int kColumns = std::numeric_limits<int>::max();
+  std::vector<int> task_of(size_t(tasks), kColumns);  // band k as -1 - k, else the columns' task
+  for (int k = 0; k < band_tasks; ++k) task_of[size_t(int64_t(k) * tasks / band_tasks)] = -1 - k;
+  for (int t = 0, c = 0; t < tasks; ++t)
+    if (task_of[size_t(t)] == kColumns) task_of[size_t(t)] = c++;
+  tbb::parallel_for(0, tasks, [&](int t) {
+    const int task = task_of[size_t(t)];
+    if (task < 0) {
+      (this->*band_sums_)(size_t(-1 - task), grid);
+      return;
+    }
+    const int c0 = task * per_task, c1 = std::min(g_.NX, c0 + per_task);
+    for (int c = c0; c < c1; ++c) {
       GridNode* const column = g_.node.data() + size_t(c) * NY;
-      for (size_t k = 0; k < NY; ++k) {
-        GridNode& n = column[k];
-        if (n.m > 0.0) {
-          const double inv_m = 1.0 / n.m;
-          if (flip) {
-            // vx0 held the force impulse; it becomes the pre-force velocity
-            const double v0x = n.vx * inv_m, v0y = n.vy * inv_m;
-            n.vx = v0x + n.vx0 * inv_m + gx;
-            n.vy = v0y + n.vy0 * inv_m + gy;
-            n.vx0 = v0x;
-            n.vy0 = v0y;
-          } else {
-            n.vx = n.vx * inv_m + gx;
-            n.vy = n.vy * inv_m + gy;
-          }
+      GridNode* from = column;
+      const int i = c - Grid::kPad;
+      for (const FieldPlan* box : boxes)
+        if (box->i0 <= i && i <= box->i1) {
+          update_nodes(from, column + (box->j0 + Grid::kPad), gx, gy, flip);
+          from = column + (box->j1 + Grid::kPad + 1);
         }
-      }
-      if (walls) walls_on_column(c - Grid::kPad, wall_impulse_[size_t(c)]);
+      update_nodes(from, column + NY, gx, gy, flip);
+      if (walls) walls_on_column(i, wall_impulse_[size_t(c)]);
     }
   });
-  if (walls) sum_wall_impulses();
+  if (grid && walls) sum_wall_impulses();
 }
 
 // G2P and the constitutive update. Fused, each block of particles gets both while it is in cache

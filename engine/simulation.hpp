@@ -1,6 +1,6 @@
 // Explicit plane-strain MPM over an immutable Scene. One step reads like the algorithm:
-//   particles_to_grid (zeroing the grid as it goes) -> grid_update (with the walls no body
-//   reaches) -> bodies_and_walls
+//   particles_to_grid (zeroing the grid as it goes) -> grid_and_bands (the grid update, with the
+//   walls no body reaches and cell_fraction's band sums) -> bodies_and_walls
 //   -> grid_to_particles -> constitutive_update -> advance_bodies
 // Particles and grid are structures of arrays; the shape-function kernel and the material law are
 // chosen once per scene (templates), so the hot loops carry no per-particle feature branches.
@@ -72,7 +72,7 @@ struct Particles {
 // One grid node, interleaved so a particle's 3x3 stencil touches few cache lines.
 struct GridNode {
   double m;         // mass (kg per metre)
-  double vx, vy;    // momentum during transfer, velocity after grid_update
+  double vx, vy;    // momentum during transfer, velocity after the grid update
   double vx0, vy0;  // FLIP only: force impulse during transfer, pre-force velocity after
 };
 
@@ -219,7 +219,7 @@ class Simulation {
   void sample_body_fields();
   void weigh_rim(size_t b);
   template <class Kernel, bool Flip> void particles_to_grid();
-  void grid_update(bool walls);
+  void grid_and_bands(bool walls, bool grid, bool bands);
   bool walls_apart_from_bodies() const;
   void bodies_and_walls(bool walls_done);
   template <class Kernel> void contact_particles();
@@ -227,7 +227,8 @@ class Simulation {
   template <class Kernel> void solve_contact_points();
   template <class Kernel> void apply_contact_impulse(const ContactPoint& c, const Vec2& J);
   template <bool Fraction> void contact_nodes();
-  template <class Kernel> void contact_cell_fraction();
+  template <class Kernel> bool plan_cell_fraction();
+  template <class Kernel> void cell_fraction_band(size_t task, bool update_nodes);
   void contact_walls();
   void walls_on_column(int i, std::array<Vec2, 4>& impulse);
   void sum_wall_impulses();
@@ -283,6 +284,8 @@ class Simulation {
   int strip_rows_ = 0;
   double drift_y_m_ = 0.0;
   template <class Kernel> std::pair<uint32_t, uint32_t> strip_rows_span(int strip, double y_lo_m, double y_hi_m) const;
+  std::pair<uint32_t, uint32_t> strip_rows_of_bases(int strip, int base_lo, int base_hi) const;
+  std::pair<uint32_t, uint32_t> strip_rows(int strip, int base_lo, int base_hi) const;
   bool strayed_ = false, homes_stale_ = false;
   Reorders reorders_;
   void (Simulation::*reorder_)() = nullptr;
@@ -328,6 +331,23 @@ class Simulation {
   double body_node_full_kg_ = 0.0;
   std::vector<std::vector<double>> body_node_mass_kg_;
   std::vector<std::vector<double>> band_field_;  // cell_fraction: each band's own copy of the field (scratch)
+  // cell_fraction this step (plan_cell_fraction): per body its node box, its bands (tasks
+  // first_task ..) and its field's lattice weights (a body that never turns); one task per band
+  struct FieldPlan {
+    int i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+    int bands = 1;
+    size_t first_task = 0;
+    std::vector<int> column_base, row_base;
+    std::vector<double> column_w, row_w;
+  };
+  struct BandTask {
+    size_t body;
+    int i0, i1, j0, j1;  // the nodes it adds to (and in the grid update's region updates)
+  };
+  std::vector<FieldPlan> field_plans_;
+  std::vector<BandTask> band_tasks_;
+  bool (Simulation::*plan_bands_)() = nullptr;
+  void (Simulation::*band_sums_)(size_t, bool) = nullptr;
   // cell-fraction contact, per body over its node box: the points' summed velocity changes (kg m/s)
   // and the mass they came with (kg), both weighted by the points' weights
   std::vector<std::vector<Vec2>> stencil_dv_kg_m_s_;

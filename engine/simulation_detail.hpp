@@ -48,12 +48,38 @@ inline NodeBox body_node_box(const BodyState& s, const Grid& g) {
           std::max(-Grid::kPad, int(std::floor(lo.y())) - 1), std::min(g.ny + Grid::kPad, int(std::ceil(hi.y())) + 1)};
 }
 
-// The first and last P2G strips whose points may lie between x_lo_m and x_hi_m: a strip either
-// side more than the points there now, since a point may have strayed from its strip.
-template <class K> inline std::pair<int, int> strip_span(double x_lo_m, double x_hi_m, double inv_dx, int strips) {
+// The grid update of nodes [first, end) of a column: momentum to velocity, plus gravity (FLIP: vx0
+// held the force impulse and becomes the pre-force velocity). Node by node, so the bits do not
+// depend on which task updates which nodes (grid_and_bands).
+inline void update_nodes(GridNode* first, GridNode* end, double gx, double gy, bool flip) {
+  for (GridNode* n = first; n < end; ++n) {
+    if (n->m <= 0.0) continue;
+    const double inv_m = 1.0 / n->m;
+    if (flip) {
+      const double v0x = n->vx * inv_m, v0y = n->vy * inv_m;
+      n->vx = v0x + n->vx0 * inv_m + gx;
+      n->vy = v0y + n->vy0 * inv_m + gy;
+      n->vx0 = v0x;
+      n->vy0 = v0y;
+    } else {
+      n->vx = n->vx * inv_m + gx;
+      n->vy = n->vy * inv_m + gy;
+    }
+  }
+}
+
+// The first and last P2G strips that may hold points whose stencil starts at node columns
+// base_lo .. base_hi. Until the next reorder a point's base lies within its strip's window (one
+// column beyond its nominal bases either way; G2P reorders as soon as one strays further), so
+// strips holding base b are those from of_base(b - 1) to of_base(b + 1).
+template <class K> inline std::pair<int, int> strips_of_bases(int base_lo, int base_hi, int strips) {
   using W = StripWindow<K>;
-  const int first = W::of_base(K::base(x_lo_m * inv_dx), strips), last = W::of_base(K::base(x_hi_m * inv_dx), strips);
-  return {std::max(first - 1, 0), std::min(last + 1, strips - 1)};
+  return {W::of_base(base_lo - 1, strips), W::of_base(base_hi + 1, strips)};
+}
+
+// The strips whose points may lie between x_lo_m and x_hi_m.
+template <class K> inline std::pair<int, int> strip_span(double x_lo_m, double x_hi_m, double inv_dx, int strips) {
+  return strips_of_bases<K>(K::base(x_lo_m * inv_dx), K::base(x_hi_m * inv_dx), strips);
 }
 
 // The strips whose points may lie within `reach_m` of a body's box.

@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
+#include <vector>
 
 #include "engine/bodies.hpp"
 #include "engine/scene/scene_io.hpp"
@@ -165,6 +167,37 @@ TEST(Mpm, AnyThreadCountGivesOneThreadsBits) {
     EXPECT_EQ(a.particles().pressure, b.particles().pressure);
     EXPECT_EQ(a.particles().pressure, c.particles().pressure);
   }
+}
+
+// cell_fraction's bands add up in the grid update's region, each updating its own nodes first,
+// only where the bodies' node boxes are apart; two plates a cell apart share nodes, so their bands
+// run after the whole grid is updated. Their forces keep one thread's bits on any thread count,
+// and the two mirror images push down alike and apart alike.
+TEST(Mpm, BodiesSharingNodesGiveOneThreadsBitsOnAnyThreadCount) {
+  Scene s = bed_scene(0.2, 0.1, 0.03, 0.005, 1.0);
+  const double L = 0.04, gap = 0.005;  // one cell: the boxes (a node of margin each) overlap
+  s.bodies.push_back(plate(L, 0.01, 0.1 - 0.5 * (L + gap), 0.101, Vec2(0.0, -0.2)));
+  s.bodies.push_back(plate(L, 0.01, 0.1 + 0.5 * (L + gap), 0.101, Vec2(0.0, -0.2)));
+  s.bodies[1].name = "right";
+  s.solver.contact = ContactMethod::CellFraction;
+  std::vector<std::unique_ptr<Simulation>> runs;
+  for (int threads : {1, 2, 7}) {
+    s.solver.threads = threads;
+    runs.push_back(std::make_unique<Simulation>(s));
+  }
+  int steps_differ = 0;
+  for (int k = 0; k < 300; ++k)
+    for (auto& run : runs) {
+      run->step();
+      for (size_t b = 0; b < 2; ++b) steps_differ += run->bodies()[b].force_N_per_m != runs[0]->bodies()[b].force_N_per_m;
+    }
+  EXPECT_EQ(steps_differ, 0);
+  EXPECT_EQ(runs[0]->particles().x, runs[1]->particles().x);
+  EXPECT_EQ(runs[0]->particles().x, runs[2]->particles().x);
+  const Vec2 left = runs[0]->bodies()[0].force_N_per_m, right = runs[0]->bodies()[1].force_N_per_m;
+  ASSERT_GT(left.y(), 0.0);  // the bed pushes back
+  EXPECT_NEAR(right.y(), left.y(), 0.02 * left.y());
+  EXPECT_NEAR(right.x(), -left.x(), 0.02 * left.y());
 }
 
 // The force's bits at every step too where G2P's safety net puts points back on a body's surface
