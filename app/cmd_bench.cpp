@@ -121,6 +121,7 @@ int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps,
               particles, steps, repeats);
   std::printf("wall seconds per phase over the steps, and (in brackets) the speedup over %d thread%s\n",
               rows.front().threads, rows.front().threads == 1 ? "" : "s");
+  std::printf("grid includes cell_fraction's band sums (run beside the columns); contact is their plan and the node pass\n");
   const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
   auto phases = [](const PhaseSeconds& ph) {
     return std::array<double, 6>{ph.p2g,     ph.grid,   ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,

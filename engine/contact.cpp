@@ -223,7 +223,7 @@ void Simulation::bodies_and_walls(bool walls_done) {
 // the force steps with a period of one cell.
 //
 // Cell-fraction contact (Fraction): the body is also a mass field on the grid, scattered from
-// sample points fixed in its frame (contact_cell_fraction), and a node takes the share
+// sample points fixed in its frame (cell_fraction_band), and a node takes the share
 // m_body / (m_body + m_media) of the correction, as multi-field contact of the media against a
 // body of finite mass would (Bardenhagen et al. 2001), scaled up to reach 1 where the field
 // covers the node fully, since a driven body has no finite mass. The share is a smooth function
@@ -233,7 +233,7 @@ void Simulation::bodies_and_walls(bool walls_done) {
 // it). One normal per node flips where the node crosses a thin body's medial axis (a node row of
 // a plate two cells thick, which then stopped holding the material below it: the larger part of
 // the node method's comb, and of a mass-gradient normal's); the points' normals do not, since
-// each point stays on its own side. Nodes act only once touched (contact_cell_fraction).
+// each point stays on its own side. Nodes act only once touched (cell_fraction_band).
 template <bool Fraction>
 void Simulation::contact_nodes() {
   const double dt = dt_s_, dx = g_.dx;
