@@ -20,7 +20,7 @@ constexpr char kCheckpointMagic[8] = {'F', 'U', 'R', 'R', 'O', 'W', 'C', 'K'};
 // 3: P2G's strip ranges (the points' home strips). Versions 1 and 2 are read and the points sorted
 // into strips again before the next step.
 // 4: bodies carry an angle, angular velocity and torque.
-// 5: where each strip's rows start and the points' y drift since (strip_rows_span); a version 3 or
+// 5: where each strip's rows start and the points' y drift since (strip_rows_of_bases); a version 3 or
 // 4 file walks whole strips until the next reorder, as those builds did.
 constexpr uint32_t kCheckpointVersion = 5;
 

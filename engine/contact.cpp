@@ -336,7 +336,6 @@ bool Simulation::plan_cell_fraction() {
     const bool by_columns = i1 - i0 > j1 - j0;
     const int across = by_columns ? i1 - i0 + 1 : j1 - j0 + 1, first_line = by_columns ? i0 : j0;
     plan.bands = threads == 1 ? 1 : std::clamp(std::min(across / 4, threads), 1, across);
-    plan.first_task = band_tasks_.size();
     for (int band = 0; band < plan.bands; ++band) {
       const int a = first_line + int(int64_t(across) * band / plan.bands);
       const int z = first_line + int(int64_t(across) * (band + 1) / plan.bands) - 1;

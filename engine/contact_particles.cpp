@@ -34,7 +34,7 @@ void Simulation::find_contact_points() {
   const size_t nb = bodies_.size();
   const auto& P = p_;
   // candidates: points within two cells of a body's box (no point moves a cell in a step), found
-  // in the strips and rows whose points may lie there (body_strip_span, strip_rows_span), then put
+  // in the strips and rows whose points may lie there (body_strip_span, strip_rows_of_bases), then put
   // in (particle, body) order so the list is the same for any thread count
   const double reach = 2.0 * dx;
   const int strips = int(strip_start_.size()) - 1;
@@ -52,7 +52,7 @@ void Simulation::find_contact_points() {
     if (strip < spans[b].first || strip > spans[b].second) return;
     const BodyState& s = bodies_[b];
     const double y_lo = s.position_m.y() + s.lo_m.y() - reach, y_hi = s.position_m.y() + s.hi_m.y() + reach;
-    const auto [first, end] = strip_rows_span<K>(strip, y_lo, y_hi);
+    const auto [first, end] = strip_rows_of_bases(strip, K::base(y_lo * inv_dx), K::base(y_hi * inv_dx));
     for (uint32_t p = first; p < end; ++p) {
       const Vec2 q = Vec2(P.x[p], P.y[p]) - s.position_m;
       if (q.x() < s.lo_m.x() - reach || q.y() < s.lo_m.y() - reach || q.x() > s.hi_m.x() + reach ||

@@ -40,7 +40,7 @@ void Simulation::reorder_particles() {
   std::partial_sum(start.begin(), start.end(), start.begin());
   strip_start_.resize(size_t(strips) + 1);
   for (int s = 0; s <= strips; ++s) strip_start_[size_t(s)] = start[size_t(s) * strip_keys];
-  // where each row of each strip starts, for searches bounded in y (strip_rows_span)
+  // where each row of each strip starts, for searches bounded in y (strip_rows_of_bases)
   strip_rows_ = rows;
   strip_row_start_.resize(size_t(strips) * size_t(rows) + 1);
   for (size_t r = 0; r < strip_row_start_.size(); ++r) strip_row_start_[r] = start[r * W::width];
@@ -76,27 +76,16 @@ void Simulation::reorder_particles() {
   });
 }
 
-// The points of `strip` that may now lie between y_lo_m and y_hi_m, as one range in memory order:
-// the rows they could have been sorted into at the reorder (drift_y_m_ either side, and a row more
-// for round-off). A superset: callers keep their own test.
-template <class K>
-std::pair<uint32_t, uint32_t> Simulation::strip_rows_span(int strip, double y_lo_m, double y_hi_m) const {
-  const double inv = 1.0 / g_.dx;
-  return strip_rows(strip, K::base((y_lo_m - drift_y_m_) * inv) - 1, K::base((y_hi_m + drift_y_m_) * inv) + 1);
-}
-
-// The same for the points whose stencil now starts at node rows base_lo .. base_hi: a point that
-// moved at most drift_y_m_ had its base within ceil(drift / dx) rows of its base now.
+// The points of `strip` whose stencil may now start at node rows base_lo .. base_hi, as one range
+// in memory order: the rows they could have been sorted into at the reorder (a point that moved at
+// most drift_y_m_ had its base within ceil(drift / dx) rows of its base now, and a row more for
+// round-off). A superset: callers keep their own test.
 std::pair<uint32_t, uint32_t> Simulation::strip_rows_of_bases(int strip, int base_lo, int base_hi) const {
-  const int rows = int(std::ceil(drift_y_m_ / g_.dx)) + 1;
-  return strip_rows(strip, base_lo - rows, base_hi + rows);
-}
-
-// The points of `strip` sorted into stencil rows base_lo .. base_hi at the reorder.
-std::pair<uint32_t, uint32_t> Simulation::strip_rows(int strip, int base_lo, int base_hi) const {
   // resumed from a checkpoint without rows: the whole strip until the next reorder
   if (strip_row_start_.empty()) return {strip_start_[size_t(strip)], strip_start_[size_t(strip) + 1]};
-  const int r0 = std::clamp(base_lo + Grid::kPad, 0, strip_rows_ - 1), r1 = std::clamp(base_hi + Grid::kPad, 0, strip_rows_ - 1);
+  const int rows = int(std::ceil(drift_y_m_ / g_.dx)) + 1;
+  const int r0 = std::clamp(base_lo - rows + Grid::kPad, 0, strip_rows_ - 1);
+  const int r1 = std::clamp(base_hi + rows + Grid::kPad, 0, strip_rows_ - 1);
   const size_t at = size_t(strip) * size_t(strip_rows_);
   return {strip_row_start_[at + size_t(r0)], strip_row_start_[at + size_t(r1) + 1]};
 }
@@ -120,9 +109,6 @@ void Simulation::set_home_strips() {
 template void Simulation::reorder_particles<LinearKernel>();
 template void Simulation::reorder_particles<QuadraticKernel>();
 template void Simulation::reorder_particles<CubicKernel>();
-template std::pair<uint32_t, uint32_t> Simulation::strip_rows_span<LinearKernel>(int, double, double) const;
-template std::pair<uint32_t, uint32_t> Simulation::strip_rows_span<QuadraticKernel>(int, double, double) const;
-template std::pair<uint32_t, uint32_t> Simulation::strip_rows_span<CubicKernel>(int, double, double) const;
 template bool Simulation::strips_hold_for<LinearKernel>() const;
 template bool Simulation::strips_hold_for<QuadraticKernel>() const;
 template bool Simulation::strips_hold_for<CubicKernel>() const;

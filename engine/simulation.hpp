@@ -236,7 +236,7 @@ class Simulation {
   struct G2PLocal {
     int64_t projected = 0;
     double vmax2 = 0.0;
-    double dy_max_m = 0.0;  // largest move in y (strip_rows_span's drift)
+    double dy_max_m = 0.0;  // largest move in y (strip_rows_of_bases' drift)
     bool strayed = false;  // a point left its strip's window (the step ends with a reorder)
   };
   template <class Kernel, bool Flip> void g2p_range(size_t begin, size_t end, G2PLocal& loc);
@@ -279,13 +279,11 @@ class Simulation {
   // Within a strip the reorder sorts the points by stencil row: row r of strip s starts at
   // strip_row_start_[s * strip_rows_ + r]. No point has moved more than drift_y_m_ in y since
   // (G2P adds each step's largest move), so a search for the points of a band of y need only walk
-  // the rows that band could have held then (strip_rows_span).
+  // the rows that band could have held then (strip_rows_of_bases).
   std::vector<uint32_t> strip_row_start_;
   int strip_rows_ = 0;
   double drift_y_m_ = 0.0;
-  template <class Kernel> std::pair<uint32_t, uint32_t> strip_rows_span(int strip, double y_lo_m, double y_hi_m) const;
   std::pair<uint32_t, uint32_t> strip_rows_of_bases(int strip, int base_lo, int base_hi) const;
-  std::pair<uint32_t, uint32_t> strip_rows(int strip, int base_lo, int base_hi) const;
   bool strayed_ = false, homes_stale_ = false;
   Reorders reorders_;
   void (Simulation::*reorder_)() = nullptr;
@@ -331,12 +329,11 @@ class Simulation {
   double body_node_full_kg_ = 0.0;
   std::vector<std::vector<double>> body_node_mass_kg_;
   std::vector<std::vector<double>> band_field_;  // cell_fraction: each band's own copy of the field (scratch)
-  // cell_fraction this step (plan_cell_fraction): per body its node box, its bands (tasks
-  // first_task ..) and its field's lattice weights (a body that never turns); one task per band
+  // cell_fraction this step (plan_cell_fraction): per body its node box, how many bands cut it,
+  // and its field's lattice weights (a body that never turns); one task per band
   struct FieldPlan {
     int i0 = 0, i1 = 0, j0 = 0, j1 = 0;
     int bands = 1;
-    size_t first_task = 0;
     std::vector<int> column_base, row_base;
     std::vector<double> column_w, row_w;
   };

@@ -136,7 +136,7 @@ size_t Simulation::g2p_quadratic_by_four(size_t begin, size_t end, G2PLocal& loc
     y = out ? lo : y, uy = out ? (uy < 0.0 ? zero : uy) : uy;
     out = y > hy;
     y = out ? hy : y, uy = out ? (0.0 < uy ? zero : uy) : uy;
-    const V dy = y - yp;  // strip_rows_span's drift
+    const V dy = y - yp;  // strip_rows_of_bases' drift
     for (size_t l = 0; l < count; ++l) loc.dy_max_m = std::max(loc.dy_max_m, std::abs(dy[l]));
     store(X, x);
     store(Y, y);
