@@ -9,6 +9,7 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <string>
 #include <thread>
 
 #include "app/calibration.hpp"
@@ -56,8 +57,11 @@ Scene bench_scene(ShapeFunction shape, bool dpm, int threads, double dx_m = 0.00
 
 // Particle-steps per wall second over at least `seconds` and `min_steps` steps, after 10 steps of warm-up;
 // *phases: the phase seconds of the measured steps.
-double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases, int64_t min_steps = 20) {
+// *log: the measured steps' tasks (task_log.hpp).
+double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases, int64_t min_steps = 20,
+                    TaskLog* log = nullptr) {
   for (int i = 0; i < 10; ++i) sim.step();  // first touches of memory and contact warm-up
+  sim.set_task_log(log);
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   const PhaseSeconds before = sim.phase_seconds();
@@ -75,6 +79,7 @@ double measure_rate(Simulation& sim, double seconds, PhaseSeconds* phases, int64
                ph.constitutive - before.constitutive, ph.reorder - before.reorder,
                ph.g2p_constitutive - before.g2p_constitutive};
   }
+  sim.set_task_log(nullptr);
   return double(steps) * double(sim.particles().size()) / elapsed;
 }
 
@@ -95,10 +100,72 @@ std::vector<int> parse_thread_list(const std::string& text) {
   return out;
 }
 
+// What the step's tasks allow on more threads than this machine has: for each T, one more run of
+// the steps on one thread with every task timed and the work split as a T-thread run would split
+// it (task_log.hpp). Per phase, its serial part (what ran outside its tasks, region dispatch
+// included) plus its tasks shared out on T threads, as a speedup over that run: a ceiling (no
+// thread wake-ups, memory-bandwidth limit or stealing cost) that names the phases short of work.
+void print_task_ceiling(double dx_m, int steps) {
+  constexpr auto& T = TaskLog::kThreads;
+  const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
+  constexpr size_t rows = kStepPhases + 1;
+  std::array<std::array<double, T.size()>, rows> speedup{};
+  std::array<double, rows> first_wall_s{}, first_serial_s{};
+  std::array<double, kStepPhases> tasks_per_region{};
+  for (size_t k = 1; k < T.size(); ++k) {
+    Simulation sim(bench_scene(ShapeFunction::Quadratic, false, 1, dx_m));
+    PhaseSeconds ph;
+    TaskLog log;
+    log.plan_threads = T[k];
+    measure_rate(sim, 0.0, &ph, steps, &log);
+    const std::array<double, kStepPhases> phase_s = {ph.p2g, ph.grid, ph.contact,
+                                                     ph.g2p + ph.constitutive + ph.g2p_constitutive, ph.reorder};
+    double wall_s = 0.0, at_s = 0.0, serial_s = 0.0;
+    for (size_t i = 0; i < kStepPhases; ++i) {
+      const TaskLog::PhaseTasks& p = log.phases[i];
+      const double phase_wall_s = phase_s[i] - p.log_s;
+      const double phase_serial_s = std::max(0.0, phase_wall_s - p.shared_s[0]);
+      const double phase_at_s = phase_serial_s + p.shared_s[k];
+      speedup[i][k] = phase_at_s > 0.0 ? phase_wall_s / phase_at_s : 0.0;
+      wall_s += phase_wall_s, at_s += phase_at_s, serial_s += phase_serial_s;
+      if (k == 1) {
+        first_wall_s[i] = phase_wall_s, first_serial_s[i] = phase_serial_s;
+        tasks_per_region[i] = p.regions > 0 ? double(p.tasks) / double(p.regions) : 0.0;
+      }
+    }
+    speedup[kStepPhases][k] = wall_s / at_s;
+    if (k == 1) first_wall_s[kStepPhases] = wall_s, first_serial_s[kStepPhases] = serial_s;
+  }
+  std::printf("\nceiling: one-thread runs with every task timed, the work split as on T threads; a phase's serial\n"
+              "part (outside its tasks) plus its tasks shared out on T threads (each, in order, to the first free\n"
+              "one), as a speedup over the run. No thread wake-ups, memory-bandwidth limit or stealing cost: real\n"
+              "runs fall below it; a phase far below T is short of work to share\n");
+  std::printf("%-10s %9s %8s %13s", "phase", "seconds", "serial", "tasks/region");
+  for (size_t k = 1; k < T.size(); ++k) std::printf(" %6s", ("T=" + std::to_string(T[k])).c_str());
+  std::printf("\n");
+  for (size_t i = 0; i < rows; ++i) {
+    std::printf("%-10s %9.4f %7.2f%% ", names[i], first_wall_s[i],
+                100.0 * first_serial_s[i] / std::max(first_wall_s[i], 1e-30));
+    if (i < kStepPhases)
+      std::printf("%13.1f", tasks_per_region[i]);
+    else
+      std::printf("%13s", "");
+    for (size_t k = 1; k < T.size(); ++k) {
+      if (speedup[i][k] > 0.0)
+        std::printf(" %5.1fx", speedup[i][k]);
+      else
+        std::printf(" %6s", "-");  // the phase did not run (the reorder in a few steps)
+    }
+    std::printf("\n");
+  }
+  std::printf("(seconds, serial and tasks/region: the T=%d run; grid's tasks include one band per thread, up to a\n"
+              "band per 4 node lines of a body's box)\n", T[1]);
+}
+
 // `--threads LIST`: where a step stops scaling. The bench scene (quadratic NDPM) for a fixed number of
 // steps on each thread count, best of `repeats` runs by total time; prints each phase's seconds and
 // its speedup over the first count. Writes no calibration.
-int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps, int repeats) {
+int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps, int repeats, bool ceiling) {
   struct Row {
     int threads;
     double rate;
@@ -147,6 +214,7 @@ int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps,
   std::printf("share of a %d-thread step:", rows.front().threads);
   for (size_t k = 0; k + 1 < base.size(); ++k) std::printf(" %s %.1f%%", names[k], 100.0 * base[k] / base.back());
   std::printf("\n");
+  if (ceiling) print_task_ceiling(dx_m, steps);
   return 0;
 }
 
@@ -161,9 +229,10 @@ int bench_main(const Parsed& p) {
     const long steps = std::strtol(steps_text.c_str(), &end, 10);
     if (steps_text.empty() || *end != '\0' || steps < 1 || steps > 1000000)
       throw UsageError("--steps " + steps_text + ": expected a number of steps from 1 to 1000000");
-    return bench_scaling(counts, dx_m, int(steps), 2);
+    return bench_scaling(counts, dx_m, int(steps), 2, p.has("--ceiling"));
   }
-  if (p.has("--dx") || p.has("--steps")) throw UsageError("--dx and --steps go with --threads (the scaling table)");
+  if (p.has("--dx") || p.has("--steps") || p.has("--ceiling"))
+    throw UsageError("--dx, --steps and --ceiling go with --threads (the scaling table)");
   const std::string sec_text = p.get("--seconds", "2");
   const double seconds = std::strtod(sec_text.c_str(), &end);
   if (sec_text.empty() || *end != '\0' || !(seconds > 0.0) || seconds > 600.0)
@@ -229,7 +298,7 @@ int bench_main(const Parsed& p) {
 Command command_bench() {
   return {"bench",
           "measure this machine's solver speed so validate, run and study can predict wall times",
-          "furrow bench [--seconds S] [--out FILE]\n       furrow bench --threads 1,2,4,... [--dx M] [--steps N]",
+          "furrow bench [--seconds S] [--out FILE]\n       furrow bench --threads 1,2,4,... [--dx M] [--steps N] [--ceiling]",
           "Runs the single-plate scene (plate_intrusion at dx 5 mm, about 115k particles, the plate in the\n"
           "bed) for S seconds with each shape function (linear, quadratic, cubic), each model (NDPM; DPM\n"
           "with dilatancy) on one thread and on all cores, prints the particle-steps per second and the\n"
@@ -244,13 +313,18 @@ Command command_bench() {
           "With --threads LIST it measures where a step stops scaling instead: quadratic NDPM on the same\n"
           "scene (dx M, default 0.005 m) for N steps (default 300) after 10 of warm-up on each thread count,\n"
           "best of two runs each, and prints the wall seconds of each phase with its speedup over the\n"
-          "first count. Nothing is stored.",
+          "first count. With --ceiling it then runs the steps on one thread once for each T in 2, 4, ... 64\n"
+          "with every parallel task timed and the work split as on T threads, and prints what each phase's\n"
+          "serial part and tasks allow on T threads: where a step would stop scaling on a machine with\n"
+          "more cores than this one, short of work to share (wake-ups and memory bandwidth aside). Nothing\n"
+          "is stored.",
           {{"--seconds", true, false, "seconds per measurement (default 2)", "S"},
            {"--out", true, false, "calibration file to write (replaced)", "FILE"},
            {"--quiet", false, false, "no header line on stderr"},
            {"--threads", true, false, "per-phase scaling over these thread counts (e.g. 1,2,4); stores nothing", "LIST"},
            {"--dx", true, false, "with --threads: grid spacing of the scene in m (default 0.005)", "M"},
-           {"--steps", true, false, "with --threads: steps measured per run (default 300)", "N"}},
+           {"--steps", true, false, "with --threads: steps measured per run (default 300)", "N"},
+           {"--ceiling", false, false, "with --threads: also the speedups the tasks allow on 2 to 64 threads"}},
           0,
           0,
           bench_main};

@@ -1,6 +1,5 @@
 // Particle contact (solver.contact "particle"): impulses on the material points that would reach a
 // body, solved by Gauss-Seidel over the points.
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -44,7 +43,7 @@ void Simulation::find_contact_points() {
     const BodyState& s = bodies_[b];
     spans[b] = body_strip_span<K>(s, reach, inv_dx, strips);
   }
-  tbb::parallel_for(size_t(0), contact_chunks_.size(), [&](size_t k) {
+  for_tasks(task_log_, StepPhase::Contact, contact_chunks_.size(), [&](size_t k) {
     const size_t b = k / size_t(strips);
     const int strip = int(k % size_t(strips));
     auto& out = contact_chunks_[k];
@@ -77,7 +76,7 @@ void Simulation::find_contact_points() {
   contacts_.resize(nc);
   std::vector<uint8_t> keep(nc, 0);
   const bool friction = scene_.effects.body_friction;
-  tbb::parallel_for(size_t(0), nc, [&](size_t k) {
+  for_tasks(task_log_, StepPhase::Contact, nc, [&](size_t k) {
     const uint32_t p = cand[2 * k], b = cand[2 * k + 1];
     const BodyState& s = bodies_[b];
     const Shape& shape = scene_.bodies[b].shape;

@@ -1,8 +1,5 @@
 // The particles' memory order: sorted by P2G strip, then by stencil, every kReorderSteps steps or
 // when a point strays from its strip.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cstddef>
 #include <numeric>
@@ -21,23 +18,69 @@ namespace furrow {
 template <class K>
 void Simulation::reorder_particles() {
   using W = StripWindow<K>;
+  const bool homes_known = !homes_stale_;
   homes_stale_ = strayed_ = false;
   const size_t n = p_.size();
   const double inv = 1.0 / g_.dx;
   const int strips = W::count(g_.nx), rows = g_.ny + 2 * Grid::kPad + 1;
   const size_t strip_keys = size_t(rows) * W::width;
   std::vector<uint32_t> key(n), start(size_t(strips) * strip_keys + 1, 0), perm(n);
-  const tbb::blocked_range<size_t> all(0, n, size_t(1) << 14);
-  tbb::parallel_for(all, [&](const auto& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
+  // the parallel passes in fixed chunks of points
+  constexpr size_t kChunk = size_t(1) << 12;
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  auto in_chunks = [&](const auto& pass) {
+    for_tasks(task_log_, StepPhase::Reorder, chunks, [&](size_t c) { pass(c * kChunk, std::min(n, c * kChunk + kChunk)); });
+  };
+  in_chunks([&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
       const int base = K::base(p_.x[i] * inv), strip = W::of_base(base, strips);
       const int column = std::clamp(base - W::width * (strip - 1), 0, W::width - 1);
       const int cy = std::clamp(K::base(p_.y[i] * inv) + Grid::kPad, 0, rows - 1);
       key[i] = uint32_t((size_t(strip) * rows + cy) * W::width + column);
     }
   });
-  for (size_t i = 0; i < n; ++i) ++start[key[i] + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
+  // A stable counting sort by key. On more than one thread, by groups of strips: a point kept its
+  // stencil within its home strip's window, so its strip now is its home strip or one beside it,
+  // and the points of strips a..b lie in the home ranges of strips a - 1 .. b + 1. Each group
+  // counts and places its own keys walking those ranges in memory order, as one pass would: the
+  // same permutation. If a point strayed further, the groups miss it and one pass does it all.
+  const int threads = task_log_ && task_log_->plan_threads > 0 ? task_log_->plan_threads
+                                                               : tbb::this_task_arena::max_concurrency();
+  const int groups = threads > 1 && homes_known && strip_start_.size() == size_t(strips) + 1
+                         ? std::clamp(strips / 8, 1, 4 * threads)
+                         : 0;
+  const std::vector<uint32_t> home_start = strip_start_;
+  auto group_strips = [&](size_t g) { return std::pair(int(g * size_t(strips) / size_t(groups)), int((g + 1) * size_t(strips) / size_t(groups))); };
+  auto group_points = [&](int a, int b) {  // the home ranges of strips a - 1 .. b (b one past the group's last)
+    return std::pair(home_start[size_t(std::max(a - 1, 0))], home_start[size_t(std::min(b + 1, strips))]);
+  };
+  std::vector<uint32_t> group_total(size_t(groups), 0);
+  for_tasks(task_log_, StepPhase::Reorder, size_t(groups), [&](size_t g) {
+    const auto [a, b] = group_strips(g);
+    const auto [first, end] = group_points(a, b);
+    const uint32_t lo = uint32_t(size_t(a) * strip_keys), hi = uint32_t(size_t(b) * strip_keys);
+    for (uint32_t i = first; i < end; ++i)
+      if (key[i] - lo < hi - lo) ++start[key[i] + 1];
+    for (uint32_t k = lo + 1; k < hi; ++k) start[k + 1] += start[k];
+    group_total[g] = start[hi];
+  });
+  uint32_t found = 0;
+  for (uint32_t t : group_total) found += t;
+  const bool grouped = groups > 0 && found == n;
+  reorders_.by_groups += grouped;
+  if (grouped) {
+    // each group's counts from its first point's place
+    std::vector<uint32_t> offset(size_t(groups), 0);
+    for (size_t g = 1; g < size_t(groups); ++g) offset[g] = offset[g - 1] + group_total[g - 1];
+    for_tasks(task_log_, StepPhase::Reorder, size_t(groups), [&](size_t g) {
+      const auto [a, b] = group_strips(g);
+      for (size_t k = size_t(a) * strip_keys + 1; k <= size_t(b) * strip_keys; ++k) start[k] += offset[g];
+    });
+  } else {
+    std::fill(start.begin(), start.end(), 0);
+    for (size_t i = 0; i < n; ++i) ++start[key[i] + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+  }
   strip_start_.resize(size_t(strips) + 1);
   for (int s = 0; s <= strips; ++s) strip_start_[size_t(s)] = start[size_t(s) * strip_keys];
   // where each row of each strip starts, for searches bounded in y (strip_rows_of_bases)
@@ -46,7 +89,17 @@ void Simulation::reorder_particles() {
   for (size_t r = 0; r < strip_row_start_.size(); ++r) strip_row_start_[r] = start[r * W::width];
   drift_y_m_ = 0.0;
   set_home_strips();
-  for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);
+  if (grouped) {
+    for_tasks(task_log_, StepPhase::Reorder, size_t(groups), [&](size_t g) {
+      const auto [a, b] = group_strips(g);
+      const auto [first, end] = group_points(a, b);
+      const uint32_t lo = uint32_t(size_t(a) * strip_keys), hi = uint32_t(size_t(b) * strip_keys);
+      for (uint32_t i = first; i < end; ++i)
+        if (key[i] - lo < hi - lo) perm[start[key[i]]++] = i;
+    });
+  } else {
+    for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);
+  }
   // the contact list (kept for the next step's warm start) follows its particles
   if (!contacts_.empty()) {
     for (size_t i = 0; i < n; ++i) key[perm[i]] = uint32_t(i);
@@ -69,8 +122,8 @@ void Simulation::reorder_particles() {
       else return buffer_u8;
     }();
     buffer.resize(n);
-    tbb::parallel_for(all, [&](const auto& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) buffer[i] = a[perm[i]];
+    in_chunks([&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) buffer[i] = a[perm[i]];
     });
     a.swap(buffer);
   });
@@ -101,8 +154,9 @@ bool Simulation::strips_hold_for() const {
 
 void Simulation::set_home_strips() {
   home_strip_.resize(p_.size());
-  for (size_t s = 0; s + 1 < strip_start_.size(); ++s)
+  for_tasks(task_log_, StepPhase::Reorder, strip_start_.empty() ? 0 : strip_start_.size() - 1, [&](size_t s) {
     std::fill(home_strip_.begin() + strip_start_[s], home_strip_.begin() + strip_start_[s + 1], uint16_t(s));
+  });
 }
 
 // the instances Simulation's constructor picks from

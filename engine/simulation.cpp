@@ -3,9 +3,6 @@
 // phase by phase".
 #include "engine/simulation.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,7 +24,13 @@ namespace {
 
 // grid nodes per task of the grid update: 2048 x 40 B = 80 kB, so the 34k nodes
 // of the bench bed (dx 5 mm) make 17 tasks; at 16384 they made 3, two threads split them 2:1
+// (at 1024, the bench's task ceiling on 16 threads did not move: the bands bound it)
 constexpr size_t kGridGrain = 2048;
+// particles per task of G2P and the constitutive update: 113 tasks on the 115k bench bed, so
+// sixteen threads share them to within a task of 7 (at 4096, 29 tasks of uneven cost: the bench's
+// task ceiling gave 11.2x on 16 threads). A multiple of kFusedBlock; the tasks' tallies are a
+// count, a flag and maxima, so the bits do not depend on it.
+constexpr size_t kG2PGrain = 1024;
 // particles G2P and the constitutive update take in turn when fused: their ~20 arrays of a block
 // stay in L2 (256 points x 20 x 8 B = 40 kB). Measured alone this gains nothing (README,
 // Performance); it is the shape a fused G2P + constitutive + next P2G pass would take.
@@ -294,8 +297,8 @@ void Simulation::grid_and_bands(bool walls, bool grid, bool bands) {
   for (int k = 0; k < band_tasks; ++k) task_of[size_t(int64_t(k) * tasks / band_tasks)] = -1 - k;
   for (int t = 0, c = 0; t < tasks; ++t)
     if (task_of[size_t(t)] == kColumns) task_of[size_t(t)] = c++;
-  tbb::parallel_for(0, tasks, [&](int t) {
-    const int task = task_of[size_t(t)];
+  for_tasks(task_log_, grid ? StepPhase::Grid : StepPhase::Contact, size_t(tasks), [&](size_t t) {
+    const int task = task_of[t];
     if (task < 0) {
       (this->*band_sums_)(size_t(-1 - task), grid);
       return;
@@ -321,11 +324,12 @@ void Simulation::grid_and_bands(bool walls, bool grid, bool bands) {
 // (the same arithmetic, so the same bits; no faster on its own, README); apart
 // when the front/back walls' friction must act between them, or for a profile of each phase.
 void Simulation::particles_update(bool g2p, bool constitutive) {
-  const size_t chunks = (p_.size() + kGrain - 1) / kGrain;
+  static_assert(kG2PGrain % kFusedBlock == 0, "a task's blocks are those of one pass");
+  const size_t chunks = (p_.size() + kG2PGrain - 1) / kG2PGrain;
   // one G2P tally per fixed chunk, summed in order
   std::vector<G2PLocal> locals(g2p ? chunks : 0);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    const size_t begin = c * kGrain, end = std::min(p_.size(), begin + kGrain);
+  for_tasks(task_log_, StepPhase::G2PConstitutive, chunks, [&](size_t c) {
+    const size_t begin = c * kG2PGrain, end = std::min(p_.size(), begin + kG2PGrain);
     for (size_t b = begin; b < end; b += kFusedBlock) {
       const size_t e = std::min(end, b + kFusedBlock);
       if (g2p) (this->*g2p_range_)(b, e, locals[c]);

@@ -16,6 +16,7 @@
 #include "engine/fields.hpp"
 #include "engine/materials.hpp"
 #include "engine/scene/scene.hpp"
+#include "engine/task_log.hpp"
 #include <tbb/task_arena.h>
 
 namespace furrow {
@@ -182,6 +183,7 @@ class Simulation {
   // reorders so far: on schedule (every kReorderSteps) and because a point strayed from its strip
   struct Reorders {
     int64_t scheduled = 0, strayed = 0;
+    int64_t by_groups = 0;  // reorders sorted by groups of strips in parallel (of these and any others)
   };
   const Reorders& reorders() const { return reorders_; }
   static constexpr int kReorderSteps = 64;
@@ -192,6 +194,9 @@ class Simulation {
   // The default P2G and G2P and NDPM's update four points at a time (the default) or a point at
   // a time: the same bits (tested).
   void set_by_four(bool by_four) { by_four_ = by_four; }
+  // Each parallel region of the default path times its tasks into `log` (nullptr: none), for the
+  // bench's account of what more threads would give (task_log.hpp). The same results either way.
+  void set_task_log(TaskLog* log) { task_log_ = log; }
   double wave_speed_m_s() const { return wave_speed_; }
   // distance travelled by the first moving body (m), for end_displacement and averaging windows
   double lead_body_travel_m() const;
@@ -351,6 +356,7 @@ class Simulation {
   std::vector<std::vector<double>> stencil_mass_kg_;
   std::vector<std::vector<uint32_t>> contact_chunks_;
   std::unique_ptr<tbb::task_arena> arena_;
+  TaskLog* task_log_ = nullptr;
 };
 
 // The instruction set this engine was compiled for (CMake picks the build machine's widest):

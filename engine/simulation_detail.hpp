@@ -2,11 +2,15 @@
 // box. Internal to the engine; an unnamed namespace as simd4.hpp's, for the same reason.
 #pragma once
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <immintrin.h>
 #include <utility>
+#include <vector>
 
 #include "engine/simulation.hpp"
 
@@ -14,6 +18,28 @@ namespace furrow {
 namespace {
 
 constexpr size_t kGrain = 4096;  // particles per TBB task
+
+// A parallel region of `n` tasks, task(k) for k in [0, n). With a log, each task's wall seconds go
+// to it under `phase` (task_log.hpp); the tasks and what they do are the same either way.
+template <class F> void for_tasks(TaskLog* log, StepPhase phase, size_t n, const F& task) {
+  if (!log) {
+    tbb::parallel_for(size_t(0), n, [&](size_t k) { task(k); });
+    return;
+  }
+  using clock = std::chrono::steady_clock;
+  const auto enter = clock::now();
+  std::vector<double> task_s(n, 0.0);
+  const auto start = clock::now();
+  tbb::parallel_for(size_t(0), n, [&](size_t k) {
+    const auto t0 = clock::now();
+    task(k);
+    task_s[k] = std::chrono::duration<double>(clock::now() - t0).count();
+  });
+  const auto end = clock::now();
+  log->add(phase, std::chrono::duration<double>(end - start).count(), task_s);
+  // the log's own time, which the phase's timer also counted
+  log->phases[size_t(phase)].log_s += std::chrono::duration<double>(clock::now() - end + (start - enter)).count();
+}
 
 // P2G's strips. A point whose stencil starts at node column `base` (the kernel's) belongs, when the
 // points are reordered, to strip s = floor(base / width) + 1: its nominal bases are

@@ -1,6 +1,5 @@
 // P2G: particles to grid (mass, momentum, stress and the affine terms), the default path four
 // points at a time.
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -180,7 +179,8 @@ void Simulation::particles_to_grid() {
   // both colours of strips, each strip scattered by `scatter`
   auto in_colours = [&](const auto& scatter) {
     for (int colour = 0; colour < 2; ++colour)
-      tbb::parallel_for(0, (strips + 1 - colour) / 2, [&](int k) {
+      for_tasks(task_log_, StepPhase::P2G, size_t((strips + 1 - colour) / 2), [&](size_t task) {
+        const int k = int(task);
         if (colour == 0) zero_tile(k);
         scatter(2 * k + colour);
       });

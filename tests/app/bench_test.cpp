@@ -184,4 +184,40 @@ TEST_F(BenchCli, ScalingTableHasARowPerThreadCountWhosePhasesAddUpToTheStep) {
   }
 }
 
+// `--ceiling`: a row per phase and one for the step, each speedup on T threads between 1 and T
+// (the tasks shared out can neither take longer than on one thread nor gain more than T; "-" for
+// the reorder, which five steps do not reach), and P2G split into more than one task a region.
+TEST_F(BenchCli, CeilingGivesEveryPhaseASpeedupBetweenOneAndTheThreads) {
+  const auto r = run({"bench", "--threads", "1", "--dx", "0.01", "--steps", "5", "--ceiling"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::regex row(R"(^(p2g|grid|contact|g2p\+const|reorder|step) +([0-9.]+) +([0-9.]+)% +([0-9.]*)((?: +(?:[0-9.]+x|-)){6}) *$)");
+  const std::regex cell(R"(([0-9.]+)x|-)");  // "-": the phase did not run (no reorder in 5 steps)
+  const int T[] = {2, 4, 8, 16, 32, 64};
+  std::vector<std::string> names;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (!std::regex_match(line, m, row)) continue;
+    names.push_back(m[1]);
+    if (m[1] == "p2g") {
+      EXPECT_GT(std::stod(m[4]), 1.0) << line;
+    }
+    const std::string rest = m[5];
+    int k = 0;
+    for (std::sregex_iterator it(rest.begin(), rest.end(), cell), end; it != end; ++it, ++k) {
+      if ((*it)[0] == "-") {
+        EXPECT_EQ(m[1], "reorder") << line;
+        continue;
+      }
+      const double speedup = std::stod((*it)[1]);
+      EXPECT_GE(speedup, 0.95) << line;  // printed to 0.1
+      EXPECT_LE(speedup, T[k] + 0.05) << line;
+    }
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"p2g", "grid", "contact", "g2p+const", "reorder", "step"})) << r.out;
+  const auto b = run({"bench", "--ceiling"});
+  EXPECT_EQ(b.status, 2);
+  EXPECT_NE(b.err.find("--ceiling"), std::string::npos) << b.err;
+}
+
 }  // namespace
