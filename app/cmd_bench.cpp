@@ -100,11 +100,14 @@ std::vector<int> parse_thread_list(const std::string& text) {
   return out;
 }
 
-// What the step's tasks allow on more threads than this machine has: for each T, one more run of
-// the steps on one thread with every task timed and the work split as a T-thread run would split
-// it (task_log.hpp). Per phase, its serial part (what ran outside its tasks, region dispatch
-// included) plus its tasks shared out on T threads, as a speedup over that run: a ceiling (no
+// What the step's tasks allow on more threads than this machine has: for each T of 1, 2, ... 64,
+// one run of the steps on one thread with every task timed and the work split as a T-thread run
+// would split it (task_log.hpp). Per phase, its serial part (what ran outside its tasks, dispatch
+// included) plus its tasks shared out on T threads, as a speedup over the T = 1 run: a ceiling (no
 // thread wake-ups, memory-bandwidth limit or stealing cost) that names the phases short of work.
+// Some splits add work as T grows (cell_fraction's bands, the reorder's groups), so the speedup is
+// over the one-thread split's time, rescaled to each run's pace by P2G and G2P, whose work is the
+// same in every run (the shared VM's pace drifts between runs).
 void print_task_ceiling(double dx_m, int steps) {
   constexpr auto& T = TaskLog::kThreads;
   // a task's two clock reads cost one read outside its timed span, which an untimed run does not pay
@@ -114,11 +117,10 @@ void print_task_ceiling(double dx_m, int steps) {
   for (int i = 0; i < kReads; ++i) (void)clock::now();
   const double read_s = std::chrono::duration<double>(clock::now() - t0).count() / kReads;
   const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
-  constexpr size_t rows = kStepPhases + 1;
-  std::array<std::array<double, T.size()>, rows> speedup{};
-  std::array<double, rows> first_wall_s{}, first_serial_s{};
-  std::array<double, kStepPhases> tasks_per_region{};
-  for (size_t k = 1; k < T.size(); ++k) {
+  constexpr size_t kP2G = size_t(StepPhase::P2G), kG2P = size_t(StepPhase::G2PConstitutive);
+  std::array<std::array<double, kStepPhases>, T.size()> wall_s{}, at_s{};
+  std::array<double, kStepPhases> serial_s{}, tasks_per_region{};
+  for (size_t k = 0; k < T.size(); ++k) {
     Simulation sim(bench_scene(ShapeFunction::Quadratic, false, 1, dx_m));
     PhaseSeconds ph;
     TaskLog log;
@@ -126,46 +128,48 @@ void print_task_ceiling(double dx_m, int steps) {
     measure_rate(sim, 0.0, &ph, steps, &log);
     const std::array<double, kStepPhases> phase_s = {ph.p2g, ph.grid, ph.contact,
                                                      ph.g2p + ph.constitutive + ph.g2p_constitutive, ph.reorder};
-    double wall_s = 0.0, at_s = 0.0, serial_s = 0.0;
     for (size_t i = 0; i < kStepPhases; ++i) {
       const TaskLog::PhaseTasks& p = log.phases[i];
-      const double phase_wall_s = phase_s[i] - p.log_s - double(p.tasks) * read_s;
-      const double phase_serial_s = std::max(0.0, phase_wall_s - p.shared_s[0]);
-      const double phase_at_s = phase_serial_s + p.shared_s[k];
-      speedup[i][k] = phase_at_s > 0.0 ? phase_wall_s / phase_at_s : 0.0;
-      wall_s += phase_wall_s, at_s += phase_at_s, serial_s += phase_serial_s;
-      if (k == 1) {
-        first_wall_s[i] = phase_wall_s, first_serial_s[i] = phase_serial_s;
+      wall_s[k][i] = phase_s[i] - p.log_s - double(p.tasks) * read_s;
+      const double serial = std::max(0.0, wall_s[k][i] - p.shared_s[0]);
+      at_s[k][i] = serial + p.shared_s[k];
+      if (k == 0) {
+        serial_s[i] = serial;
         tasks_per_region[i] = p.regions > 0 ? double(p.tasks) / double(p.regions) : 0.0;
       }
     }
-    speedup[kStepPhases][k] = wall_s / at_s;
-    if (k == 1) first_wall_s[kStepPhases] = wall_s, first_serial_s[kStepPhases] = serial_s;
   }
   std::printf("\nceiling: one-thread runs with every task timed, the work split as on T threads; a phase's serial\n"
               "part (outside its tasks) plus its tasks shared out on T threads (each, in order, to the first free\n"
-              "one), as a speedup over the run. No thread wake-ups, memory-bandwidth limit or stealing cost: real\n"
-              "runs fall below it; a phase far below T is short of work to share\n");
+              "one), as a speedup over the one-thread split. No thread wake-ups, memory-bandwidth limit or\n"
+              "stealing cost: real runs fall below it; a phase far below T is short of work to share\n");
   std::printf("%-10s %9s %8s %13s", "phase", "seconds", "serial", "tasks/region");
   for (size_t k = 1; k < T.size(); ++k) std::printf(" %6s", ("T=" + std::to_string(T[k])).c_str());
   std::printf("\n");
-  for (size_t i = 0; i < rows; ++i) {
-    std::printf("%-10s %9.4f %7.2f%% ", names[i], first_wall_s[i],
-                100.0 * first_serial_s[i] / std::max(first_wall_s[i], 1e-30));
-    if (i < kStepPhases)
+  auto pace = [&](size_t k) { return (wall_s[k][kP2G] + wall_s[k][kG2P]) / (wall_s[0][kP2G] + wall_s[0][kG2P]); };
+  for (size_t i = 0; i <= kStepPhases; ++i) {
+    const bool step = i == kStepPhases;
+    double one_s = 0.0, one_serial_s = 0.0;
+    for (size_t j = 0; j < kStepPhases; ++j)
+      if (step || j == i) one_s += wall_s[0][j], one_serial_s += serial_s[j];
+    std::printf("%-10s %9.4f %7.2f%% ", names[i], one_s, 100.0 * one_serial_s / std::max(one_s, 1e-30));
+    if (!step)
       std::printf("%13.1f", tasks_per_region[i]);
     else
       std::printf("%13s", "");
     for (size_t k = 1; k < T.size(); ++k) {
-      if (speedup[i][k] > 0.0)
-        std::printf(" %5.1fx", speedup[i][k]);
+      double at = 0.0;
+      for (size_t j = 0; j < kStepPhases; ++j)
+        if (step || j == i) at += at_s[k][j];
+      if (one_s > 0.0 && at > 0.0)
+        std::printf(" %5.1fx", one_s * pace(k) / at);
       else
         std::printf(" %6s", "-");  // the phase did not run (the reorder in a few steps)
     }
     std::printf("\n");
   }
-  std::printf("(seconds, serial and tasks/region: the T=%d run; grid's tasks include one band per thread, up to a\n"
-              "band per 4 node lines of a body's box)\n", T[1]);
+  std::printf("(seconds, serial and tasks/region: the one-thread split; on T threads the grid update adds a band\n"
+              "of cell_fraction's sums per thread, up to one per 4 node lines of a body's box)\n");
 }
 
 // `--threads LIST`: where a step stops scaling. The bench scene (quadratic NDPM) for a fixed number of
@@ -319,11 +323,11 @@ Command command_bench() {
           "With --threads LIST it measures where a step stops scaling instead: quadratic NDPM on the same\n"
           "scene (dx M, default 0.005 m) for N steps (default 300) after 10 of warm-up on each thread count,\n"
           "best of two runs each, and prints the wall seconds of each phase with its speedup over the\n"
-          "first count. With --ceiling it then runs the steps on one thread once for each T in 2, 4, ... 64\n"
-          "with every parallel task timed and the work split as on T threads, and prints what each phase's\n"
-          "serial part and tasks allow on T threads: where a step would stop scaling on a machine with\n"
-          "more cores than this one, short of work to share (wake-ups and memory bandwidth aside). Nothing\n"
-          "is stored.",
+          "first count. With --ceiling it then runs the steps on one thread once for each T in 1, 2, 4, ...\n"
+          "64 with every parallel task timed and the work split as on T threads, and prints the speedup\n"
+          "each phase's serial part and tasks allow on T threads over one thread's split: where a step\n"
+          "would stop scaling on a machine with more cores than this one, short of work to share\n"
+          "(wake-ups and memory bandwidth aside). Nothing is stored.",
           {{"--seconds", true, false, "seconds per measurement (default 2)", "S"},
            {"--out", true, false, "calibration file to write (replaced)", "FILE"},
            {"--quiet", false, false, "no header line on stderr"},
