@@ -2,6 +2,7 @@
 // points at a time.
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <immintrin.h>
 #include <type_traits>
@@ -163,7 +164,8 @@ void Simulation::particles_to_grid() {
   // P2G zeroes the grid as it goes, no pass of its own: colour 0's strip 2k owns the node columns
   // from its first, W (2k - 1) - 1, to the next even strip's first (the first and last tiles reach
   // the grid's edges). That tile holds every node the strip writes (W >= N + 1), the tiles cover
-  // the grid, and colour 1 starts after colour 0 ends, so every node is zero before its first sum.
+  // the grid, and an odd strip, whose nodes lie in the tiles of the even strips beside it, starts
+  // after both end, so every node is zero before its first sum.
   // A tile is zeroed just before its strip scatters into it, so it is in cache for the sums, and the
   // zeroing scales with P2G (as a pass of its own it was 1% of a step and 1.0-1.6x on two threads:
   // memory and a thread wake-up; README, Performance).
@@ -176,14 +178,21 @@ void Simulation::particles_to_grid() {
     const long last = k == pairs - 1 ? NX : std::clamp(long(W::width) * (2 * k + 1) - 1 + Grid::kPad, first, NX);
     std::fill(grid + first * NY, grid + last * NY, GridNode{});
   };
-  // both colours of strips, each strip scattered by `scatter`
+  // Both colours of strips in one parallel region, each strip scattered by `scatter`: an odd strip
+  // shares nodes only with the even strips beside it, so it runs as soon as both are done, on the
+  // thread that finished the second (no barrier between the colours). Each node still gets its
+  // even strip's sums, then its odd strip's, as with a colour at a time: the same bits.
   auto in_colours = [&](const auto& scatter) {
-    for (int colour = 0; colour < 2; ++colour)
-      for_tasks(task_log_, StepPhase::P2G, size_t((strips + 1 - colour) / 2), [&](size_t task) {
-        const int k = int(task);
-        if (colour == 0) zero_tile(k);
-        scatter(2 * k + colour);
-      });
+    std::vector<std::atomic<int>> waiting(size_t(strips) / 2);  // odd strip 2k + 1's even neighbours
+    for (int k = 0; k < strips / 2; ++k) waiting[size_t(k)].store(2 * k + 2 < strips ? 2 : 1, std::memory_order_relaxed);
+    for_tasks(task_log_, StepPhase::P2G, size_t(pairs), [&](size_t task) {
+      const int k = int(task);
+      zero_tile(k);
+      scatter(2 * k);
+      for (int odd : {2 * k - 1, 2 * k + 1})  // acquire-release: the other neighbour's sums are seen
+        if (odd > 0 && odd < strips && waiting[size_t(odd / 2)].fetch_sub(1, std::memory_order_acq_rel) == 1)
+          scatter(odd);
+    });
   };
 #if defined(__AVX__)
   if constexpr (std::is_same_v<K, QuadraticKernel> && Flip) {

@@ -22,8 +22,8 @@ TEST(TaskLog, ListScheduleSharesTasksInOrderToTheFirstFreeThread) {
 }
 
 // A run with its tasks timed, with the bands split as for sixteen threads, keeps an untimed run's
-// bits at every step; the log holds every region of the default path (two P2G colours, one grid
-// update with the bands, one G2P pass a step) with their tasks' seconds, which sum to no more than
+// bits at every step; the log holds every region of the default path (P2G, one grid update with
+// the bands, one G2P pass a step) with their tasks' seconds, which sum to no more than
 // the regions' wall time on one thread.
 TEST(TaskLog, TimingTheTasksChangesNoResult) {
   Scene s = test_scenes::bed_scene(0.4, 0.1, 0.03, 0.005, 1.0);
@@ -46,7 +46,7 @@ TEST(TaskLog, TimingTheTasksChangesNoResult) {
   const auto& p2g = log.phases[size_t(StepPhase::P2G)];
   const auto& grid = log.phases[size_t(StepPhase::Grid)];
   const auto& g2p = log.phases[size_t(StepPhase::G2PConstitutive)];
-  EXPECT_EQ(p2g.regions, 2 * steps);
+  EXPECT_EQ(p2g.regions, steps);
   EXPECT_EQ(grid.regions, steps);
   EXPECT_EQ(g2p.regions, steps);
   EXPECT_EQ(g2p.tasks % steps, 0);  // the same tasks every step
