@@ -100,6 +100,12 @@ std::vector<int> parse_thread_list(const std::string& text) {
   return out;
 }
 
+// The bench's phases in StepPhase order, then the whole step (G2P and the constitutive update as one).
+constexpr const char* kPhaseNames[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
+std::array<double, kStepPhases + 1> bench_phases(const PhaseSeconds& ph) {
+  return {ph.p2g, ph.grid, ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive, ph.reorder, ph.total()};
+}
+
 // What the step's tasks allow on more threads than this machine has: for each T of 1, 2, ... 64,
 // one run of the steps on one thread with every task timed and the work split as a T-thread run
 // would split it (task_log.hpp). Per phase, its serial part (what ran outside its tasks, dispatch
@@ -116,7 +122,6 @@ void print_task_ceiling(double dx_m, int steps) {
   const auto t0 = clock::now();
   for (int i = 0; i < kReads; ++i) (void)clock::now();
   const double read_s = std::chrono::duration<double>(clock::now() - t0).count() / kReads;
-  const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
   constexpr size_t kP2G = size_t(StepPhase::P2G), kG2P = size_t(StepPhase::G2PConstitutive);
   std::array<std::array<double, kStepPhases>, T.size()> wall_s{}, at_s{};
   std::array<double, kStepPhases> serial_s{}, tasks_per_region{};
@@ -126,8 +131,7 @@ void print_task_ceiling(double dx_m, int steps) {
     TaskLog log;
     log.plan_threads = T[k];
     measure_rate(sim, 0.0, &ph, steps, &log);
-    const std::array<double, kStepPhases> phase_s = {ph.p2g, ph.grid, ph.contact,
-                                                     ph.g2p + ph.constitutive + ph.g2p_constitutive, ph.reorder};
+    const auto phase_s = bench_phases(ph);
     for (size_t i = 0; i < kStepPhases; ++i) {
       const TaskLog::PhaseTasks& p = log.phases[i];
       wall_s[k][i] = phase_s[i] - p.log_s - double(p.tasks) * read_s;
@@ -152,7 +156,7 @@ void print_task_ceiling(double dx_m, int steps) {
     double one_s = 0.0, one_serial_s = 0.0;
     for (size_t j = 0; j < kStepPhases; ++j)
       if (step || j == i) one_s += wall_s[0][j], one_serial_s += serial_s[j];
-    std::printf("%-10s %9.4f %7.2f%% ", names[i], one_s, 100.0 * one_serial_s / std::max(one_s, 1e-30));
+    std::printf("%-10s %9.4f %7.2f%% ", kPhaseNames[i], one_s, 100.0 * one_serial_s / std::max(one_s, 1e-30));
     if (!step)
       std::printf("%13.1f", tasks_per_region[i]);
     else
@@ -199,18 +203,13 @@ int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps,
   std::printf("wall seconds per phase over the steps, and (in brackets) the speedup over %d thread%s\n",
               rows.front().threads, rows.front().threads == 1 ? "" : "s");
   std::printf("grid includes cell_fraction's band sums (run beside the columns); contact is their plan and the node pass\n");
-  const char* names[] = {"p2g", "grid", "contact", "g2p+const", "reorder", "step"};
-  auto phases = [](const PhaseSeconds& ph) {
-    return std::array<double, 6>{ph.p2g,     ph.grid,   ph.contact, ph.g2p + ph.constitutive + ph.g2p_constitutive,
-                                 ph.reorder, ph.total()};
-  };
   std::printf("%7s %19s", "threads", "M particle-steps/s");
-  for (const char* n : names) std::printf(" %17s", n);
+  for (const char* n : kPhaseNames) std::printf(" %17s", n);
   std::printf("\n");
-  const auto base = phases(rows.front().ph);
+  const auto base = bench_phases(rows.front().ph);
   for (const Row& row : rows) {
     std::printf("%7d %19.2f", row.threads, row.rate / 1e6);
-    const auto now = phases(row.ph);
+    const auto now = bench_phases(row.ph);
     for (size_t k = 0; k < now.size(); ++k) {
       char cell[32];
       if (now[k] > 0.0 && base[k] > 0.0)
@@ -222,7 +221,7 @@ int bench_scaling(const std::vector<int>& thread_counts, double dx_m, int steps,
     std::printf("\n");
   }
   std::printf("share of a %d-thread step:", rows.front().threads);
-  for (size_t k = 0; k + 1 < base.size(); ++k) std::printf(" %s %.1f%%", names[k], 100.0 * base[k] / base.back());
+  for (size_t k = 0; k + 1 < base.size(); ++k) std::printf(" %s %.1f%%", kPhaseNames[k], 100.0 * base[k] / base.back());
   std::printf("\n");
   if (ceiling) print_task_ceiling(dx_m, steps);
   return 0;
@@ -280,10 +279,11 @@ int bench_main(const Parsed& p) {
         const double rate = measure_rate(sim, seconds, &ph);
         c.entries.push_back({shape_names[int(shape)], dpm ? "dpm" : "ndpm", threads, rate});
         if (shape == ShapeFunction::Quadratic && !dpm && threads == thread_counts.back()) reference_rate = rate;
-        auto share = [&](double phase) { return 100.0 * phase / ph.total(); };
+        const auto phase = bench_phases(ph);
+        auto share = [&](StepPhase p) { return 100.0 * phase[size_t(p)] / phase.back(); };
         std::printf("%-10s %-5s %7d %19.2f   %21s %5.1f %5.1f %7.1f %9.1f %7.1f\n", shape_names[int(shape)],
-                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(ph.p2g), share(ph.grid),
-                    share(ph.contact), share(ph.g2p + ph.constitutive + ph.g2p_constitutive), share(ph.reorder));
+                    dpm ? "dpm" : "ndpm", threads, rate / 1e6, "", share(StepPhase::P2G), share(StepPhase::Grid),
+                    share(StepPhase::Contact), share(StepPhase::G2PConstitutive), share(StepPhase::Reorder));
         std::fflush(stdout);
       }
   // the same at the paper's dx 1.25 mm (16 times the points, 1.84M): how the rate falls with the

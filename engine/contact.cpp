@@ -320,8 +320,7 @@ bool Simulation::plan_cell_fraction() {
   stencil_nn_.resize(bodies_.size());
   field_plans_.resize(bodies_.size());
   band_tasks_.clear();
-  const int threads = task_log_ && task_log_->plan_threads > 0 ? task_log_->plan_threads
-                                                               : tbb::this_task_arena::max_concurrency();
+  const int threads = split_threads(task_log_);
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const BodyState& s = bodies_[b];
     FieldPlan& plan = field_plans_[b];

@@ -44,23 +44,31 @@ void Simulation::reorder_particles() {
   // and the points of strips a..b lie in the home ranges of strips a - 1 .. b + 1. Each group
   // counts and places its own keys walking those ranges in memory order, as one pass would: the
   // same permutation. If a point strayed further, the groups miss it and one pass does it all.
-  const int threads = task_log_ && task_log_->plan_threads > 0 ? task_log_->plan_threads
-                                                               : tbb::this_task_arena::max_concurrency();
+  const int threads = split_threads(task_log_);
   const int groups = threads > 1 && homes_known && strip_start_.size() == size_t(strips) + 1
                          ? std::clamp(strips / 8, 1, 4 * threads)
                          : 0;
   const std::vector<uint32_t> home_start = strip_start_;
-  auto group_strips = [&](size_t g) { return std::pair(int(g * size_t(strips) / size_t(groups)), int((g + 1) * size_t(strips) / size_t(groups))); };
-  auto group_points = [&](int a, int b) {  // the home ranges of strips a - 1 .. b (b one past the group's last)
-    return std::pair(home_start[size_t(std::max(a - 1, 0))], home_start[size_t(std::min(b + 1, strips))]);
+  // group g: strips a .. b - 1, so keys a strip_keys .. b strip_keys - 1
+  auto group_strips = [&](size_t g) {
+    return std::pair(g * size_t(strips) / size_t(groups), (g + 1) * size_t(strips) / size_t(groups));
+  };
+  auto group_keys = [&](size_t g) {
+    const auto [a, b] = group_strips(g);
+    return std::pair(uint32_t(a * strip_keys), uint32_t(b * strip_keys));
+  };
+  // each point of group g's keys, in memory order, from the home ranges of strips a - 1 .. b
+  auto each_point_of_group = [&](size_t g, const auto& point) {
+    const auto [a, b] = group_strips(g);
+    const auto [lo, hi] = group_keys(g);
+    const uint32_t end = home_start[std::min(b + 1, size_t(strips))];
+    for (uint32_t i = home_start[a > 0 ? a - 1 : 0]; i < end; ++i)
+      if (key[i] - lo < hi - lo) point(i);
   };
   std::vector<uint32_t> group_total(size_t(groups), 0);
   for_tasks(task_log_, StepPhase::Reorder, size_t(groups), [&](size_t g) {
-    const auto [a, b] = group_strips(g);
-    const auto [first, end] = group_points(a, b);
-    const uint32_t lo = uint32_t(size_t(a) * strip_keys), hi = uint32_t(size_t(b) * strip_keys);
-    for (uint32_t i = first; i < end; ++i)
-      if (key[i] - lo < hi - lo) ++start[key[i] + 1];
+    each_point_of_group(g, [&](uint32_t i) { ++start[key[i] + 1]; });
+    const auto [lo, hi] = group_keys(g);
     for (uint32_t k = lo + 1; k < hi; ++k) start[k + 1] += start[k];
     group_total[g] = start[hi];
   });
@@ -73,11 +81,11 @@ void Simulation::reorder_particles() {
     std::vector<uint32_t> offset(size_t(groups), 0);
     for (size_t g = 1; g < size_t(groups); ++g) offset[g] = offset[g - 1] + group_total[g - 1];
     for_tasks(task_log_, StepPhase::Reorder, size_t(groups), [&](size_t g) {
-      const auto [a, b] = group_strips(g);
-      for (size_t k = size_t(a) * strip_keys + 1; k <= size_t(b) * strip_keys; ++k) start[k] += offset[g];
+      const auto [lo, hi] = group_keys(g);
+      for (uint32_t k = lo + 1; k <= hi; ++k) start[k] += offset[g];
     });
   } else {
-    std::fill(start.begin(), start.end(), 0);
+    if (groups > 0) std::fill(start.begin(), start.end(), 0);  // the groups' counts, which missed a point
     for (size_t i = 0; i < n; ++i) ++start[key[i] + 1];
     std::partial_sum(start.begin(), start.end(), start.begin());
   }
@@ -91,11 +99,7 @@ void Simulation::reorder_particles() {
   set_home_strips();
   if (grouped) {
     for_tasks(task_log_, StepPhase::Reorder, size_t(groups), [&](size_t g) {
-      const auto [a, b] = group_strips(g);
-      const auto [first, end] = group_points(a, b);
-      const uint32_t lo = uint32_t(size_t(a) * strip_keys), hi = uint32_t(size_t(b) * strip_keys);
-      for (uint32_t i = first; i < end; ++i)
-        if (key[i] - lo < hi - lo) perm[start[key[i]]++] = i;
+      each_point_of_group(g, [&](uint32_t i) { perm[start[key[i]]++] = i; });
     });
   } else {
     for (size_t i = 0; i < n; ++i) perm[start[key[i]]++] = uint32_t(i);

@@ -41,6 +41,12 @@ template <class F> void for_tasks(TaskLog* log, StepPhase phase, size_t n, const
   log->phases[size_t(phase)].log_s += std::chrono::duration<double>(clock::now() - end + (start - enter)).count();
 }
 
+// The thread count that work split by threads is split for (cell_fraction's bands, the reorder's
+// groups): the arena's, or the log's plan_threads, so a one-thread run times a larger run's tasks.
+inline int split_threads(const TaskLog* log) {
+  return log && log->plan_threads > 0 ? log->plan_threads : tbb::this_task_arena::max_concurrency();
+}
+
 // P2G's strips. A point whose stencil starts at node column `base` (the kernel's) belongs, when the
 // points are reordered, to strip s = floor(base / width) + 1: its nominal bases are
 // [width (s - 1), width s - 1]. Until the next reorder it may stray one column either way: its
